@@ -1,0 +1,130 @@
+// One simulated s-bot: the ODE bodies, geoms and joints built from its RobotDescription, and the
+// actuator side of the standard s-bot API (sbot.h, seed Appendix A) in the API's own units.
+// Sensors live in their own modules and read the robot through linkPose()/world ray casts.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <ode/ode.h>
+
+#include "sbot_sim/core/effects.h"
+#include "sbot_sim/core/geom_info.h"
+#include "sbot_sim/core/random_streams.h"
+#include "sbot_sim/core/robot_description.h"
+#include "sbot_sim/core/types.h"
+
+namespace sbot {
+
+class World;
+
+struct JointState {
+  std::string name;
+  double position = 0;  ///< [rad]
+  double velocity = 0;  ///< [rad/s]
+  double effort = 0;    ///< [N m] motor torque applied last step
+};
+
+class Robot {
+ public:
+  Robot(World& world, const RobotDescription& description, const std::string& name, int index,
+        const Pose& base_pose);
+  ~Robot();
+  Robot(const Robot&) = delete;
+  Robot& operator=(const Robot&) = delete;
+
+  const std::string& name() const { return name_; }
+  int index() const { return index_; }
+  const RobotDescription& description() const { return *description_; }
+  const std::string& level() const { return description_->level; }
+
+  // ---- standard s-bot API, actuator side (units as sbot.h) -------------------------------------
+  /// Track speeds in API units (1 unit = 2.8 mm/s). Clamped to [-127,127] as the API documents,
+  /// then limited to +-speed_limit_units (70) as the seed's simulator does. Returns true if either
+  /// value had to be changed.
+  bool setSpeed(int left, int right);
+  /// Measured track speeds (wheel rotation), API units, in [-127,127].
+  void getSpeed(int* left, int* right) const;
+  /// Motor torques applied last step, API units (2.4412 mN m), in [-127,127].
+  void getTrackTorque(int* left, int* right) const;
+  /// Turret position target in API units of 2 degrees, clamped to [-100,100]. Returns true if clamped.
+  bool setTurretRotation(int pos);
+  int getTurretRotation() const;
+  int getTurretRotationTorque() const;
+
+  // ---- continuous access (SI) ------------------------------------------------------------------
+  /// Requested track surface speeds [m/s] (the same limit applies). Used by cmd_vel.
+  void setTrackSpeeds(double left_mps, double right_mps);
+  double requestedLeft() const { return req_left_; }
+  double requestedRight() const { return req_right_; }
+  /// Measured track surface speeds [m/s] from wheel rotation.
+  double trackSpeedLeft() const;
+  double trackSpeedRight() const;
+  /// Turret angle [rad] relative to the treels.
+  double turretAngle() const;
+
+  /// World pose of the base_link frame.
+  Pose basePose() const;
+  /// World pose of any URDF link, including massless sensor frames merged into a body.
+  Pose linkPose(const std::string& link) const;
+  bool hasLink(const std::string& link) const { return link_index_.count(link) != 0; }
+  Vec3 linearVelocity() const;   ///< of base_link's body, world frame [m/s]
+  Vec3 angularVelocity() const;  ///< world frame [rad/s]
+  std::vector<JointState> jointStates() const;
+
+  /// Move the robot so base_link sits at `pose` with zero velocity (teleport).
+  void setBasePose(const Pose& pose);
+
+  RandomStreams& random() { return random_; }
+
+  // ---- used by World -----------------------------------------------------------------------------
+  void applyCommands(double dt, const std::vector<EffectPtr>& effects);
+  void readFeedback();
+  dBodyID baseBody() const;
+  dSpaceID space() const { return space_; }
+  const std::vector<dBodyID>& bodies() const { return bodies_; }
+  std::size_t geomCount() const { return geoms_.size(); }
+
+ private:
+  struct LinkFrame {
+    int body = -1;          ///< index into bodies_
+    Pose body_T_link;       ///< link frame in the body (centre of mass) frame
+  };
+  struct Hinge {
+    std::string name;
+    dJointID id = nullptr;
+    dJointFeedback feedback{};
+    Vec3 axis_in_child = Vec3::UnitZ();
+    int child_body = -1;
+    double effort = 0;      ///< torque about the axis, last step [N m]
+  };
+
+  void build(const Pose& base_pose);
+  const Hinge* hinge(const std::string& joint) const;
+  double hingeRate(const Hinge& h) const;
+  double hingeAngle(const Hinge& h) const;
+
+  World& world_;
+  const RobotDescription* description_;
+  std::string name_;
+  int index_;
+  RandomStreams random_;
+
+  std::vector<dBodyID> bodies_;
+  std::vector<dGeomID> geoms_;
+  std::vector<std::unique_ptr<GeomInfo>> geom_infos_;
+  dSpaceID space_ = nullptr;             ///< this robot's geoms; never collided with itself
+  std::vector<Hinge> hinges_;
+  std::map<std::string, int> hinge_index_;
+  std::map<std::string, LinkFrame> link_index_;
+  std::vector<int> left_hinges_, right_hinges_;
+  int turret_hinge_ = -1;
+  Pose base_body_T_base_;                ///< base_link in its body's (centre of mass) frame
+
+  double req_left_ = 0, req_right_ = 0;  ///< requested track speeds [m/s]
+  double turret_target_ = 0;             ///< [rad]
+};
+
+}  // namespace sbot

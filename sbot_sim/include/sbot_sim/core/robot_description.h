@@ -1,0 +1,101 @@
+// What the core needs to build one s-bot in ODE: the URDF (links, inertias, collision shapes, joints,
+// limits; parsed with urdfdom) plus the level's sidecar `<level>.sbot.yaml` (simulation semantics URDF
+// cannot express: which joints drive the tracks, unit conversions, contact materials, sensor models).
+// Both files are generated from sbot_description/config/sbot_parameters.yaml; see that package.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "sbot_sim/core/types.h"
+
+namespace sbot {
+
+struct CollisionShape {
+  enum class Type { Sphere, Cylinder, Box };
+  Type type = Type::Sphere;
+  double radius = 0;       ///< sphere, cylinder [m]
+  double length = 0;       ///< cylinder along its local z [m]
+  Vec3 size = Vec3::Zero();///< box edge lengths [m]
+  Pose origin;             ///< in the link frame
+};
+
+struct LinkDescription {
+  std::string name;
+  double mass = 0;                 ///< [kg]; 0 for massless frames (sensors, markers)
+  Pose inertial_origin;            ///< centre of mass frame in the link frame
+  Mat3 inertia = Mat3::Zero();     ///< [kg m^2] about the centre of mass, in the inertial frame
+  std::vector<CollisionShape> collisions;
+  std::string material = "body";   ///< contact material (sidecar `materials`), see ContactConfig
+};
+
+struct JointDescription {
+  enum class Type { Fixed, Revolute, Continuous };
+  std::string name, parent, child;
+  Type type = Type::Fixed;
+  Pose origin;                     ///< child frame in the parent frame
+  Vec3 axis = Vec3::UnitZ();       ///< in the child frame
+  double lower = 0, upper = 0;     ///< [rad], revolute only
+  double effort = 0;               ///< [N m] URDF limit (the motor's maximum torque)
+  double velocity = 0;             ///< [rad/s] URDF limit
+};
+
+/// Track drive ("treels"): API speed units to wheel angular velocity, torque limits. Table 2.2.
+struct TreelsSemantics {
+  std::vector<std::string> left_joints, right_joints;  ///< driven wheel hinges, +rotation = forward
+  double wheel_radius = 0.022;       ///< [m] used for the unit conversion of every driven wheel
+  std::map<std::string, double> wheel_radii;  ///< per-joint override [m] (mixed wheel sizes)
+  double max_torque = 0.21971;       ///< [N m] per track at the axle (90 units)
+  double torque_unit = 0.0024412;    ///< [N m] per API torque unit
+  double speed_unit = 0.0028;        ///< [m/s] per API speed unit
+  int speed_limit_units = 70;        ///< simulator limit (seed 2.2.1); API range is [-127,127]
+};
+
+/// Turret servo. Table 2.3.
+struct TurretSemantics {
+  std::string joint;                 ///< empty when the level has no turret joint
+  double speed = 0.5;                ///< [rad/s]
+  double unit = 0.034906585;         ///< [rad] per API unit (2 degrees)
+  int range_units = 100;             ///< API range [-range, range]
+  double max_torque = 1.0;           ///< [N m]
+  double torque_unit = 0.0117176;    ///< [N m] per API torque unit
+};
+
+struct RobotDescription {
+  std::string level;                 ///< fast, simple, basic, medium, detailed
+  std::string urdf_path, sidecar_path, urdf_xml;
+  std::string root_link;
+  std::vector<LinkDescription> links;      ///< root first, then parents before children
+  std::vector<JointDescription> joints;    ///< in the same order as the child links
+  TreelsSemantics treels;
+  TurretSemantics turret;
+  double recommended_step = 0.01;          ///< [s]
+  double gravity = 9.81;                   ///< [m/s^2] the level's world gravity (Fast: reduced)
+  std::map<std::string, std::string> extra;///< sidecar `extra` scalars (sensor models, ...), as text
+  YAML::Node sidecar;                      ///< the whole sidecar, for modules with structured entries
+
+  const LinkDescription* findLink(const std::string& name) const;
+  const JointDescription* findJoint(const std::string& name) const;
+  double totalMass() const;
+  /// Radius converting API speed units to this driven joint's rad/s.
+  double wheelRadius(const std::string& joint) const;
+  std::string extraOr(const std::string& key, const std::string& fallback) const;
+};
+
+/// Parse one URDF and its sidecar. Throws ConfigError naming the file and field on bad input.
+RobotDescription loadRobotDescription(const std::string& urdf_path, const std::string& sidecar_path);
+
+/// Directory holding `urdf/<level>.urdf` and `urdf/<level>.sbot.yaml`: $SBOT_DESCRIPTION_DIR if
+/// set, otherwise the sbot_description source directory this library was built against.
+std::string descriptionDirectory();
+
+/// The five model levels, cheapest first.
+const std::vector<std::string>& modelLevels();
+
+/// Load a level by name from descriptionDirectory(); cached, so spawning many robots parses once.
+const RobotDescription& loadLevel(const std::string& level);
+
+}  // namespace sbot

@@ -1,0 +1,46 @@
+// Scenario files (config/scenarios/*.yaml): world settings, seed and the robots to spawn.
+//
+//   seed: 42                      # root of every random stream
+//   duration: 60                  # [s] simulated, 0 = run until stopped
+//   world:
+//     step: 0.01                  # [s]
+//     gravity: 9.81               # [m/s^2]
+//     solver_iterations: 40
+//     contact: {mu: 1.0, erp: 0.2, cfm: 1.0e-5, coulomb: true, materials: {caster: 0.0}}
+//     terrain:
+//       type: plane               # plane | composite | rough
+//       boxes: [{name: wall_n, center: [0, 2, 0.05], size: [4, 0.02, 0.1], yaw: 0, surface: white_paper}]
+//       arena: {size: 4.0, height: 0.1}   # shorthand: four walls around the origin
+//   robots:                       # explicit robots ...
+//     - {name: sbot_0, level: simple, pose: {x: 0, y: 0, yaw: 0}}
+//   swarm:                        # ... and/or generated ones, named sbot_<i> after the explicit ones
+//     {count: 20, level: simple, layout: grid, spacing: 0.3, center: [0, 0]}   # layout grid|random
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "sbot_sim/core/types.h"
+#include "sbot_sim/core/world_config.h"
+
+namespace sbot {
+
+struct RobotSpawn {
+  std::string name;
+  std::string level = "simple";
+  Pose2D pose;
+};
+
+struct Scenario {
+  std::string source;            ///< file it was read from
+  WorldConfig world;
+  std::vector<RobotSpawn> robots;
+  double duration = 0;           ///< [s], 0 = unlimited
+};
+
+/// Parse a scenario. `robot_count` >= 0 overrides swarm.count. Throws ConfigError naming the file
+/// and the field for anything malformed (unknown level, negative step, non-numeric pose, ...).
+Scenario loadScenario(const std::string& path, int robot_count = -1);
+Scenario parseScenario(const std::string& yaml_text, const std::string& source, int robot_count = -1);
+
+}  // namespace sbot

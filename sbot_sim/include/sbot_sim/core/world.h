@@ -1,0 +1,86 @@
+// The simulated world: one ODE world and collision space, the terrain, the robots, and the fixed-step
+// loop. No ROS here: the simulator node, benchmarks, validation and calibration all drive this class.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <ode/ode.h>
+
+#include "sbot_sim/core/effects.h"
+#include "sbot_sim/core/robot.h"
+#include "sbot_sim/core/world_config.h"
+
+namespace sbot {
+
+struct RayHit {
+  bool hit = false;
+  double distance = 0;         ///< [m] along the ray
+  Vec3 point = Vec3::Zero();
+  Vec3 normal = Vec3::UnitZ();
+  std::string surface;         ///< material / surface label of what was hit
+  const Robot* robot = nullptr;///< the robot hit, if any
+};
+
+class World {
+ public:
+  explicit World(const WorldConfig& config);
+  ~World();
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  /// Spawn a robot of `description` with base_link at `pose` (x, y, yaw) resting on the terrain.
+  Robot& addRobot(const RobotDescription& description, const Pose2D& pose, const std::string& name);
+  /// Spawn at an explicit 3D pose of base_link.
+  Robot& addRobotAt(const RobotDescription& description, const Pose& pose, const std::string& name);
+  void removeRobot(const std::string& name);
+  Robot& robot(const std::string& name);            ///< throws UnknownName
+  Robot* findRobot(const std::string& name);        ///< nullptr if absent
+  std::vector<Robot*> robots();
+  std::size_t robotCount() const { return robots_.size(); }
+
+  /// Advance one fixed step: effects' command hooks, motors, collisions, integration, feedback.
+  void step();
+  void stepN(int n) { for (int i = 0; i < n; ++i) step(); }
+  double time() const { return time_; }
+  std::uint64_t stepCount() const { return steps_; }
+  const WorldConfig& config() const { return config_; }
+
+  /// Height of the terrain (ground plane, boxes, height field) under (x, y) [m].
+  double terrainHeight(double x, double y) const;
+  /// Cast a ray; `ignore` (optional) is not hit (a sensor's own robot).
+  RayHit castRay(const Vec3& origin, const Vec3& direction, double length, const Robot* ignore) const;
+
+  void addEffect(EffectPtr effect) { effects_.push_back(std::move(effect)); }
+  const std::vector<EffectPtr>& effects() const { return effects_; }
+  void clearEffects() { effects_.clear(); }
+
+  dWorldID odeWorld() const { return world_; }
+  dSpaceID space() const { return space_; }
+  dJointGroupID contactGroup() const { return contacts_; }
+
+  // internal: collision callback trampoline
+  void handlePair(dGeomID a, dGeomID b);
+
+ private:
+  void buildTerrain();
+  Robot* robotOwning(dGeomID g) const;
+  const std::string& materialOf(dGeomID g) const;
+
+  WorldConfig config_;
+  dWorldID world_ = nullptr;
+  dSpaceID space_ = nullptr;
+  dJointGroupID contacts_ = nullptr;
+  std::vector<dGeomID> static_geoms_;
+  std::map<dGeomID, std::string> static_material_;
+  std::vector<std::unique_ptr<Robot>> robots_;
+  std::vector<EffectPtr> effects_;
+  double time_ = 0;
+  std::uint64_t steps_ = 0;
+  int next_index_ = 0;
+  std::vector<double> heightfield_;   ///< row-major heights for Rough terrain [m]
+  dHeightfieldDataID heightfield_data_ = nullptr;
+};
+
+}  // namespace sbot

@@ -1,0 +1,65 @@
+// Configuration of a simulated world: integration, contacts, terrain. Filled from a scenario YAML
+// (scenario.h) or directly by headless tools (benchmarks, validation, calibration).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "sbot_sim/core/types.h"
+
+namespace sbot {
+
+/// Contact model. Materials are named by the sidecar (`materials`) and by obstacles (`surface`).
+struct ContactConfig {
+  /// Coulomb friction coefficient used for any material without its own entry. The s-bot's rubber
+  /// treels on the seed's polystyrene must hold a 30 degree slope until they topple (Table 4.1), which
+  /// needs mu >= tan(30 deg) = 0.58; we use 1.0. See README "Friction" for the 1.2 N traction figure.
+  double mu = 1.0;
+  std::map<std::string, double> material_mu;  ///< per-material coefficient; a pair uses the smaller
+  double erp = 0.2;         ///< contact error reduction (ODE soft_erp)
+  double cfm = 1e-5;        ///< contact softness (ODE soft_cfm) [m/N scaled by step]
+  double bounce = 0.0;      ///< restitution
+  int max_contacts = 4;     ///< per geom pair
+  /// false: ODE's box friction where mu is a force limit [N] per contact, like the seed's Vortex
+  /// "friction 12e4 dyne". true (default): Coulomb friction pyramid (dContactApprox1).
+  bool coulomb = true;
+
+  double muFor(const std::string& a, const std::string& b) const;
+};
+
+/// A static box: walls, steps, plateaus, gap edges, ramps (pitch tilts it about its local y axis).
+struct BoxObstacle {
+  std::string name;
+  Vec3 center = Vec3::Zero();  ///< [m]
+  Vec3 size = Vec3::Ones();    ///< full edge lengths [m]
+  double yaw = 0;              ///< [rad]
+  double pitch = 0;            ///< [rad]
+  std::string surface = "ground";  ///< contact material / optical surface label
+};
+
+struct TerrainConfig {
+  enum class Type { Plane, Composite, Rough };
+  Type type = Type::Plane;
+  bool ground_plane = true;             ///< infinite plane at z = 0 (Plane and Composite)
+  std::vector<BoxObstacle> boxes;       ///< composite planes and obstacles (any terrain type)
+  // Rough terrain (seed 2.4.1): a grey-scale image is a height map.
+  std::string heightmap_image;          ///< path; empty = generated fractal noise from `seed`
+  int resolution = 128;                 ///< samples per side when generated
+  double size_x = 5.0, size_y = 5.0;    ///< [m]
+  double height_range = 0.0;            ///< peak-to-peak height [m] (HR of Fig. 4.4 in mm / 1000)
+  std::uint64_t heightmap_seed = 1;
+};
+
+struct WorldConfig {
+  double step = 0.01;          ///< fixed integration step [s]
+  double gravity = 9.81;       ///< [m/s^2], pointing -z
+  int solver_iterations = 40;  ///< ODE quickstep iterations
+  double solver_sor = 1.3;     ///< ODE quickstep over-relaxation
+  std::uint64_t seed = 1;      ///< root of every random stream
+  ContactConfig contact;
+  TerrainConfig terrain;
+};
+
+}  // namespace sbot

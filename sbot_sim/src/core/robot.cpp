@@ -1,0 +1,330 @@
+#include "sbot_sim/core/robot.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/world.h"
+
+namespace sbot {
+namespace {
+
+constexpr int kApiLimit = 127;  // sbot.h: every track/torque value is in [-127,127]
+
+int clampInt(int v, int lo, int hi) { return std::max(lo, std::min(hi, v)); }
+int roundToUnits(double v, int limit) {
+  if (!std::isfinite(v)) return 0;
+  return clampInt(static_cast<int>(std::lround(v)), -limit, limit);
+}
+
+void toOde(const Quat& q, dQuaternion out) {
+  out[0] = q.w(); out[1] = q.x(); out[2] = q.y(); out[3] = q.z();
+}
+Pose bodyPose(dBodyID b) {
+  const dReal* p = dBodyGetPosition(b);
+  const dReal* q = dBodyGetQuaternion(b);
+  return Pose(Vec3(p[0], p[1], p[2]), Quat(q[0], q[1], q[2], q[3]));
+}
+void setBodyPose(dBodyID b, const Pose& pose) {
+  dBodySetPosition(b, pose.position.x(), pose.position.y(), pose.position.z());
+  dQuaternion q;
+  toOde(pose.orientation, q);
+  dBodySetQuaternion(b, q);
+}
+Vec3 vec(const dReal* v) { return Vec3(v[0], v[1], v[2]); }
+
+}  // namespace
+
+Robot::Robot(World& world, const RobotDescription& description, const std::string& name, int index,
+             const Pose& base_pose)
+    : world_(world), description_(&description), name_(name), index_(index),
+      random_(world.config().seed, name) {
+  build(base_pose);
+}
+
+Robot::~Robot() {
+  for (auto& h : hinges_) dJointDestroy(h.id);
+  for (dGeomID g : geoms_) dGeomDestroy(g);
+  if (space_) dSpaceDestroy(space_);
+  for (dBodyID b : bodies_) dBodyDestroy(b);
+}
+
+void Robot::build(const Pose& base_pose) {
+  const RobotDescription& d = *description_;
+  // 1. Group links into rigid bodies: a fixed joint merges the child into its parent's body.
+  //    group_T_link is each link's frame in its group's frame (the group's first link).
+  struct Group {
+    std::string first_link;
+    std::vector<std::pair<std::string, Pose>> links;  // (link, group_T_link)
+  };
+  std::vector<Group> groups{{d.root_link, {{d.root_link, Pose()}}}};
+  std::map<std::string, std::pair<int, Pose>> link_group{{d.root_link, {0, Pose()}}};
+  std::map<std::string, Pose> world_T_link{{d.root_link, base_pose}};
+  for (const auto& j : d.joints) {
+    const auto& parent = link_group.at(j.parent);
+    world_T_link[j.child] = world_T_link.at(j.parent) * j.origin;
+    if (j.type == JointDescription::Type::Fixed) {
+      Pose group_T_child = parent.second * j.origin;
+      groups[parent.first].links.emplace_back(j.child, group_T_child);
+      link_group[j.child] = {parent.first, group_T_child};
+    } else {
+      groups.push_back({j.child, {{j.child, Pose()}}});
+      link_group[j.child] = {static_cast<int>(groups.size()) - 1, Pose()};
+    }
+  }
+
+  // 2. One ODE body per group, its frame at the group's centre of mass (ODE requires that).
+  space_ = dSimpleSpaceCreate(world_.space());
+  std::vector<Pose> body_T_group(groups.size());
+  for (std::size_t gi = 0; gi < groups.size(); ++gi) {
+    dMass total;
+    dMassSetZero(&total);
+    for (const auto& [link_name, group_T_link] : groups[gi].links) {
+      const LinkDescription* link = d.findLink(link_name);
+      if (!link || link->mass <= 0) continue;
+      dMass m;
+      const Mat3& I = link->inertia;
+      dMassSetParameters(&m, link->mass, 0, 0, 0, I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2));
+      const Pose group_T_inertial = group_T_link * link->inertial_origin;
+      dMatrix3 R;
+      const Mat3 r = group_T_inertial.orientation.toRotationMatrix();
+      for (int row = 0; row < 3; ++row) {
+        for (int col = 0; col < 3; ++col) R[row * 4 + col] = r(row, col);
+        R[row * 4 + 3] = 0;
+      }
+      dMassRotate(&m, R);
+      dMassTranslate(&m, group_T_inertial.position.x(), group_T_inertial.position.y(),
+                     group_T_inertial.position.z());
+      dMassAdd(&total, &m);
+    }
+    if (total.mass <= 0) {
+      throw ConfigError(d.urdf_path, "link " + groups[gi].first_link + "/inertial",
+                        "a link moved by a joint needs mass (it and its fixed children have none)");
+    }
+    const Vec3 com(total.c[0], total.c[1], total.c[2]);
+    dMassTranslate(&total, -com.x(), -com.y(), -com.z());
+    body_T_group[gi] = Pose(-com, Quat::Identity());
+
+    dBodyID body = dBodyCreate(world_.odeWorld());
+    dBodySetMass(body, &total);
+    const Pose world_T_group = world_T_link.at(groups[gi].first_link);
+    setBodyPose(body, world_T_group * body_T_group[gi].inverse());
+    dBodySetData(body, this);
+    bodies_.push_back(body);
+
+    for (const auto& [link_name, group_T_link] : groups[gi].links) {
+      const Pose body_T_link = body_T_group[gi] * group_T_link;
+      link_index_[link_name] = {static_cast<int>(gi), body_T_link};
+      const LinkDescription* link = d.findLink(link_name);
+      if (!link) continue;
+      for (const auto& shape : link->collisions) {
+        dGeomID g = nullptr;
+        switch (shape.type) {
+          case CollisionShape::Type::Sphere: g = dCreateSphere(space_, shape.radius); break;
+          case CollisionShape::Type::Cylinder: g = dCreateCylinder(space_, shape.radius, shape.length); break;
+          case CollisionShape::Type::Box:
+            g = dCreateBox(space_, shape.size.x(), shape.size.y(), shape.size.z());
+            break;
+        }
+        dGeomSetBody(g, body);
+        const Pose offset = body_T_link * shape.origin;
+        dGeomSetOffsetPosition(g, offset.position.x(), offset.position.y(), offset.position.z());
+        dQuaternion q;
+        toOde(offset.orientation, q);
+        dGeomSetOffsetQuaternion(g, q);
+        geom_infos_.push_back(std::make_unique<GeomInfo>(GeomInfo{this, link->material, link_name}));
+        dGeomSetData(g, geom_infos_.back().get());
+        geoms_.push_back(g);
+      }
+    }
+  }
+  base_body_T_base_ = link_index_.at(d.root_link).body_T_link;
+
+  // 3. Hinges for the moving joints. Body 1 = child, body 2 = parent, so the hinge angle is the
+  //    child's rotation about the axis relative to its parent, as URDF defines it.
+  for (const auto& j : d.joints) {
+    if (j.type == JointDescription::Type::Fixed) continue;
+    const int child = link_group.at(j.child).first;
+    const int parent = link_group.at(j.parent).first;
+    Hinge h;
+    h.name = j.name;
+    h.child_body = child;
+    h.axis_in_child = j.axis;
+    h.id = dJointCreateHinge(world_.odeWorld(), nullptr);
+    dJointAttach(h.id, bodies_[child], bodies_[parent]);
+    const Pose& w = world_T_link.at(j.child);
+    const Vec3 axis = w.orientation * j.axis;
+    dJointSetHingeAnchor(h.id, w.position.x(), w.position.y(), w.position.z());
+    dJointSetHingeAxis(h.id, axis.x(), axis.y(), axis.z());
+    if (j.type == JointDescription::Type::Revolute) {
+      dJointSetHingeParam(h.id, dParamLoStop, j.lower);
+      dJointSetHingeParam(h.id, dParamHiStop, j.upper);
+    }
+    dJointSetHingeParam(h.id, dParamFMax, 0);  // passive until a module drives it
+    hinge_index_[j.name] = static_cast<int>(hinges_.size());
+    hinges_.push_back(h);
+  }
+  for (auto& h : hinges_) dJointSetFeedback(h.id, &h.feedback);  // addresses are stable now
+
+  for (const auto& jn : d.treels.left_joints) left_hinges_.push_back(hinge_index_.at(jn));
+  for (const auto& jn : d.treels.right_joints) right_hinges_.push_back(hinge_index_.at(jn));
+  if (!d.turret.joint.empty()) turret_hinge_ = hinge_index_.at(d.turret.joint);
+}
+
+const Robot::Hinge* Robot::hinge(const std::string& joint) const {
+  auto it = hinge_index_.find(joint);
+  return it == hinge_index_.end() ? nullptr : &hinges_[it->second];
+}
+
+double Robot::hingeRate(const Hinge& h) const { return dJointGetHingeAngleRate(h.id); }
+double Robot::hingeAngle(const Hinge& h) const { return dJointGetHingeAngle(h.id); }
+
+// ---- s-bot API ---------------------------------------------------------------------------------
+
+bool Robot::setSpeed(int left, int right) {
+  const int limit = description_->treels.speed_limit_units;
+  const int l = clampInt(clampInt(left, -kApiLimit, kApiLimit), -limit, limit);
+  const int r = clampInt(clampInt(right, -kApiLimit, kApiLimit), -limit, limit);
+  req_left_ = l * description_->treels.speed_unit;
+  req_right_ = r * description_->treels.speed_unit;
+  return l != left || r != right;
+}
+
+void Robot::setTrackSpeeds(double left_mps, double right_mps) {
+  const double vmax = description_->treels.speed_limit_units * description_->treels.speed_unit;
+  auto limit = [vmax](double v) { return std::isfinite(v) ? std::max(-vmax, std::min(vmax, v)) : 0.0; };
+  req_left_ = limit(left_mps);
+  req_right_ = limit(right_mps);
+}
+
+double Robot::trackSpeedLeft() const {
+  double sum = 0;
+  for (int i : left_hinges_) sum += hingeRate(hinges_[i]) * description_->wheelRadius(hinges_[i].name);
+  return left_hinges_.empty() ? 0 : sum / left_hinges_.size();
+}
+
+double Robot::trackSpeedRight() const {
+  double sum = 0;
+  for (int i : right_hinges_) sum += hingeRate(hinges_[i]) * description_->wheelRadius(hinges_[i].name);
+  return right_hinges_.empty() ? 0 : sum / right_hinges_.size();
+}
+
+void Robot::getSpeed(int* left, int* right) const {
+  const double unit = description_->treels.speed_unit;
+  if (left) *left = roundToUnits(trackSpeedLeft() / unit, kApiLimit);
+  if (right) *right = roundToUnits(trackSpeedRight() / unit, kApiLimit);
+}
+
+void Robot::getTrackTorque(int* left, int* right) const {
+  auto sum = [this](const std::vector<int>& side) {
+    double t = 0;
+    for (int i : side) t += hinges_[i].effort;
+    return t;
+  };
+  const double unit = description_->treels.torque_unit;
+  if (left) *left = roundToUnits(sum(left_hinges_) / unit, kApiLimit);
+  if (right) *right = roundToUnits(sum(right_hinges_) / unit, kApiLimit);
+}
+
+bool Robot::setTurretRotation(int pos) {
+  const int range = description_->turret.range_units;
+  const int p = clampInt(pos, -range, range);
+  turret_target_ = p * description_->turret.unit;
+  return p != pos;
+}
+
+double Robot::turretAngle() const { return turret_hinge_ < 0 ? 0 : hingeAngle(hinges_[turret_hinge_]); }
+
+int Robot::getTurretRotation() const {
+  return roundToUnits(turretAngle() / description_->turret.unit, description_->turret.range_units);
+}
+
+int Robot::getTurretRotationTorque() const {
+  if (turret_hinge_ < 0) return 0;
+  return roundToUnits(hinges_[turret_hinge_].effort / description_->turret.torque_unit, kApiLimit);
+}
+
+// ---- state ---------------------------------------------------------------------------------------
+
+dBodyID Robot::baseBody() const { return bodies_.front(); }
+
+Pose Robot::basePose() const { return bodyPose(baseBody()) * base_body_T_base_; }
+
+Pose Robot::linkPose(const std::string& link) const {
+  auto it = link_index_.find(link);
+  if (it == link_index_.end()) throw UnknownName("robot " + name_ + " has no link '" + link + "'");
+  return bodyPose(bodies_[it->second.body]) * it->second.body_T_link;
+}
+
+Vec3 Robot::linearVelocity() const {
+  // Velocity of the base_link origin, not of the body's centre of mass.
+  dVector3 v;
+  const Vec3 p = basePose().position;
+  dBodyGetPointVel(baseBody(), p.x(), p.y(), p.z(), v);
+  return Vec3(v[0], v[1], v[2]);
+}
+
+Vec3 Robot::angularVelocity() const { return vec(dBodyGetAngularVel(baseBody())); }
+
+std::vector<JointState> Robot::jointStates() const {
+  std::vector<JointState> out;
+  out.reserve(hinges_.size());
+  for (const auto& h : hinges_) out.push_back({h.name, hingeAngle(h), hingeRate(h), h.effort});
+  return out;
+}
+
+void Robot::setBasePose(const Pose& pose) {
+  const Pose old_base_body = bodyPose(baseBody());
+  const Pose new_base_body = pose * base_body_T_base_.inverse();
+  for (dBodyID b : bodies_) {
+    const Pose rel = old_base_body.inverse() * bodyPose(b);
+    setBodyPose(b, new_base_body * rel);
+    dBodySetLinearVel(b, 0, 0, 0);
+    dBodySetAngularVel(b, 0, 0, 0);
+    dBodyEnable(b);
+  }
+}
+
+// ---- stepping ------------------------------------------------------------------------------------
+
+void Robot::applyCommands(double dt, const std::vector<EffectPtr>& effects) {
+  const TreelsSemantics& tr = description_->treels;
+  TrackCommand cmd{req_left_, req_right_, tr.max_torque, tr.max_torque};
+  for (const auto& e : effects) e->onCommand(*this, cmd, dt);
+
+  auto drive = [this](const std::vector<int>& side, double speed, double max_torque) {
+    // One motor per track drives all its wheels through the rubber band: each wheel turns at the
+    // track speed and gets an equal share of the motor's torque.
+    const double share = side.empty() ? 0 : std::max(0.0, max_torque) / side.size();
+    for (int i : side) {
+      const Hinge& h = hinges_[i];
+      dJointSetHingeParam(h.id, dParamVel, speed / description_->wheelRadius(h.name));
+      dJointSetHingeParam(h.id, dParamFMax, share);
+    }
+  };
+  drive(left_hinges_, cmd.left, cmd.max_torque_left);
+  drive(right_hinges_, cmd.right, cmd.max_torque_right);
+
+  if (turret_hinge_ >= 0) {
+    // Position servo (the turret's PIC controller): proportional velocity demand capped at the
+    // turret's rotation speed, torque capped at its motor torque.
+    const TurretSemantics& ts = description_->turret;
+    const Hinge& h = hinges_[turret_hinge_];
+    constexpr double kGain = 8.0;  // [1/s]: settles within ~0.5 s, no overshoot at 10 ms steps
+    const double err = turret_target_ - hingeAngle(h);
+    dJointSetHingeParam(h.id, dParamVel, std::max(-ts.speed, std::min(ts.speed, kGain * err)));
+    dJointSetHingeParam(h.id, dParamFMax, ts.max_torque);
+  }
+}
+
+void Robot::readFeedback() {
+  for (auto& h : hinges_) {
+    // Torque the joint applied to the child body about the joint axis (motor + limit stops). The
+    // child's centre of mass lies on or near the axis, so the constraint force adds ~nothing.
+    dVector3 a;
+    dJointGetHingeAxis(h.id, a);
+    h.effort = vec(h.feedback.t1).dot(Vec3(a[0], a[1], a[2]));
+  }
+}
+
+}  // namespace sbot

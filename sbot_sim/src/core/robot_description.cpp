@@ -1,0 +1,276 @@
+#include "sbot_sim/core/robot_description.h"
+
+#include <cstdlib>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+
+#include <urdf_parser/urdf_parser.h>
+#include <yaml-cpp/yaml.h>
+
+#include "sbot_sim/core/errors.h"
+
+#ifndef SBOT_DESCRIPTION_SOURCE_DIR
+#define SBOT_DESCRIPTION_SOURCE_DIR ""
+#endif
+
+namespace sbot {
+namespace {
+
+Pose toPose(const urdf::Pose& p) {
+  double x, y, z, w;
+  p.rotation.getQuaternion(x, y, z, w);
+  return Pose(Vec3(p.position.x, p.position.y, p.position.z), Quat(w, x, y, z).normalized());
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path, "", "cannot open file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+LinkDescription convertLink(const urdf::Link& link, const std::string& file) {
+  LinkDescription out;
+  out.name = link.name;
+  if (link.inertial) {
+    const urdf::Inertial& in = *link.inertial;
+    if (!(in.mass >= 0)) throw ConfigError(file, "link " + link.name + "/inertial/mass", "must be >= 0");
+    out.mass = in.mass;
+    out.inertial_origin = toPose(in.origin);
+    out.inertia << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
+    if (in.mass > 0 && (in.ixx <= 0 || in.iyy <= 0 || in.izz <= 0)) {
+      throw ConfigError(file, "link " + link.name + "/inertial/inertia",
+                        "diagonal inertia must be positive for a link with mass");
+    }
+  }
+  for (const auto& col : link.collision_array) {
+    if (!col || !col->geometry) continue;
+    CollisionShape shape;
+    shape.origin = toPose(col->origin);
+    switch (col->geometry->type) {
+      case urdf::Geometry::SPHERE:
+        shape.type = CollisionShape::Type::Sphere;
+        shape.radius = static_cast<const urdf::Sphere&>(*col->geometry).radius;
+        break;
+      case urdf::Geometry::CYLINDER: {
+        const auto& c = static_cast<const urdf::Cylinder&>(*col->geometry);
+        shape.type = CollisionShape::Type::Cylinder;
+        shape.radius = c.radius;
+        shape.length = c.length;
+        break;
+      }
+      case urdf::Geometry::BOX: {
+        const auto& b = static_cast<const urdf::Box&>(*col->geometry);
+        shape.type = CollisionShape::Type::Box;
+        shape.size = Vec3(b.dim.x, b.dim.y, b.dim.z);
+        break;
+      }
+      default:
+        throw ConfigError(file, "link " + link.name + "/collision/geometry",
+                          "expected sphere, cylinder or box, found a mesh");
+    }
+    out.collisions.push_back(shape);
+  }
+  return out;
+}
+
+JointDescription convertJoint(const urdf::Joint& j, const std::string& file) {
+  JointDescription out;
+  out.name = j.name;
+  out.parent = j.parent_link_name;
+  out.child = j.child_link_name;
+  out.origin = toPose(j.parent_to_joint_origin_transform);
+  out.axis = Vec3(j.axis.x, j.axis.y, j.axis.z);
+  switch (j.type) {
+    case urdf::Joint::FIXED: out.type = JointDescription::Type::Fixed; break;
+    case urdf::Joint::REVOLUTE: out.type = JointDescription::Type::Revolute; break;
+    case urdf::Joint::CONTINUOUS: out.type = JointDescription::Type::Continuous; break;
+    default:
+      throw ConfigError(file, "joint " + j.name + "/type",
+                        "expected fixed, revolute or continuous (the s-bot has no other joints)");
+  }
+  if (out.type != JointDescription::Type::Fixed) {
+    if (out.axis.norm() < 1e-9) throw ConfigError(file, "joint " + j.name + "/axis", "zero axis");
+    out.axis.normalize();
+  }
+  if (j.limits) {
+    out.lower = j.limits->lower;
+    out.upper = j.limits->upper;
+    out.effort = j.limits->effort;
+    out.velocity = j.limits->velocity;
+  }
+  if (out.type == JointDescription::Type::Revolute && !(out.lower <= out.upper)) {
+    throw ConfigError(file, "joint " + j.name + "/limit", "lower limit above upper limit");
+  }
+  return out;
+}
+
+template <typename T>
+T get(const YAML::Node& node, const std::string& key, const T& fallback, const std::string& file,
+      const std::string& prefix) {
+  if (!node || !node[key]) return fallback;
+  try {
+    return node[key].as<T>();
+  } catch (const YAML::Exception&) {
+    throw ConfigError(file, prefix + key, "has the wrong type");
+  }
+}
+
+void parseSidecar(RobotDescription& d) {
+  const std::string& file = d.sidecar_path;
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(file);
+  } catch (const YAML::BadFile&) {
+    throw ConfigError(file, "", "cannot open sidecar file");
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(file, "", std::string("not valid YAML: ") + e.what());
+  }
+  d.level = get<std::string>(root, "level", "", file, "");
+  if (d.level.empty()) throw ConfigError(file, "level", "missing");
+  d.recommended_step = get<double>(root, "recommended_step", 0.01, file, "");
+  d.gravity = get<double>(root, "gravity", 9.81, file, "");
+
+  const YAML::Node t = root["treels"];
+  if (!t) throw ConfigError(file, "treels", "missing");
+  auto& tr = d.treels;
+  tr.left_joints = get<std::vector<std::string>>(t, "left_joints", {}, file, "treels.");
+  tr.right_joints = get<std::vector<std::string>>(t, "right_joints", {}, file, "treels.");
+  tr.wheel_radius = get<double>(t, "wheel_radius", tr.wheel_radius, file, "treels.");
+  tr.wheel_radii = get<std::map<std::string, double>>(t, "wheel_radii", {}, file, "treels.");
+  tr.max_torque = get<double>(t, "max_torque", tr.max_torque, file, "treels.");
+  tr.torque_unit = get<double>(t, "torque_unit", tr.torque_unit, file, "treels.");
+  tr.speed_unit = get<double>(t, "speed_unit", tr.speed_unit, file, "treels.");
+  tr.speed_limit_units = get<int>(t, "speed_limit_units", tr.speed_limit_units, file, "treels.");
+  if (tr.left_joints.empty() || tr.right_joints.empty())
+    throw ConfigError(file, "treels.left_joints/right_joints", "each track needs at least one driven joint");
+  if (!(tr.wheel_radius > 0)) throw ConfigError(file, "treels.wheel_radius", "must be > 0");
+  for (const auto& side : {tr.left_joints, tr.right_joints}) {
+    for (const auto& name : side) {
+      const JointDescription* j = d.findJoint(name);
+      if (!j) throw ConfigError(file, "treels", "driven joint '" + name + "' is not in " + d.urdf_path);
+      if (j->type != JointDescription::Type::Continuous && j->type != JointDescription::Type::Revolute)
+        throw ConfigError(file, "treels", "driven joint '" + name + "' must be continuous, found fixed");
+    }
+  }
+
+  if (const YAML::Node tu = root["turret"]) {
+    auto& tt = d.turret;
+    tt.joint = get<std::string>(tu, "joint", "", file, "turret.");
+    tt.speed = get<double>(tu, "speed", tt.speed, file, "turret.");
+    tt.unit = get<double>(tu, "unit", tt.unit, file, "turret.");
+    tt.range_units = get<int>(tu, "range_units", tt.range_units, file, "turret.");
+    tt.max_torque = get<double>(tu, "max_torque", tt.max_torque, file, "turret.");
+    tt.torque_unit = get<double>(tu, "torque_unit", tt.torque_unit, file, "turret.");
+    if (!tt.joint.empty() && !d.findJoint(tt.joint))
+      throw ConfigError(file, "turret.joint", "joint '" + tt.joint + "' is not in " + d.urdf_path);
+  }
+
+  if (const YAML::Node m = root["materials"]) {
+    for (const auto& kv : m) {
+      const auto link = kv.first.as<std::string>();
+      bool found = false;
+      for (auto& l : d.links) {
+        if (l.name == link) {
+          l.material = kv.second.as<std::string>();
+          found = true;
+        }
+      }
+      if (!found) throw ConfigError(file, "materials." + link, "no such link in " + d.urdf_path);
+    }
+  }
+  // Everything else that is a scalar is kept as text for the modules that need it.
+  if (const YAML::Node e = root["extra"]) {
+    for (const auto& kv : e) {
+      if (kv.second.IsScalar()) d.extra[kv.first.as<std::string>()] = kv.second.as<std::string>();
+    }
+  }
+  d.sidecar = root;
+}
+
+}  // namespace
+
+const LinkDescription* RobotDescription::findLink(const std::string& name) const {
+  for (const auto& l : links)
+    if (l.name == name) return &l;
+  return nullptr;
+}
+
+const JointDescription* RobotDescription::findJoint(const std::string& name) const {
+  for (const auto& j : joints)
+    if (j.name == name) return &j;
+  return nullptr;
+}
+
+double RobotDescription::totalMass() const {
+  double m = 0;
+  for (const auto& l : links) m += l.mass;
+  return m;
+}
+
+double RobotDescription::wheelRadius(const std::string& joint) const {
+  auto it = treels.wheel_radii.find(joint);
+  return it == treels.wheel_radii.end() ? treels.wheel_radius : it->second;
+}
+
+std::string RobotDescription::extraOr(const std::string& key, const std::string& fallback) const {
+  auto it = extra.find(key);
+  return it == extra.end() ? fallback : it->second;
+}
+
+RobotDescription loadRobotDescription(const std::string& urdf_path, const std::string& sidecar_path) {
+  RobotDescription d;
+  d.urdf_path = urdf_path;
+  d.sidecar_path = sidecar_path;
+  d.urdf_xml = readFile(urdf_path);
+  urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(d.urdf_xml);
+  if (!model) throw ConfigError(urdf_path, "", "not a valid URDF (urdfdom's message is printed above)");
+  if (!model->getRoot()) throw ConfigError(urdf_path, "", "URDF has no root link");
+  d.root_link = model->getRoot()->name;
+  if (d.root_link != "base_link")
+    throw ConfigError(urdf_path, "root link", "expected 'base_link', found '" + d.root_link + "'");
+
+  // Breadth-first: parents before children, so bodies can be built in one pass.
+  std::vector<urdf::LinkConstSharedPtr> queue{model->getRoot()};
+  for (std::size_t i = 0; i < queue.size(); ++i) {
+    const auto& link = queue[i];
+    d.links.push_back(convertLink(*link, urdf_path));
+    if (i > 0) d.joints.push_back(convertJoint(*link->parent_joint, urdf_path));
+    for (const auto& child : link->child_links) queue.push_back(child);
+  }
+  parseSidecar(d);
+  return d;
+}
+
+std::string descriptionDirectory() {
+  if (const char* env = std::getenv("SBOT_DESCRIPTION_DIR")) {
+    if (*env) return env;
+  }
+  return SBOT_DESCRIPTION_SOURCE_DIR;
+}
+
+const std::vector<std::string>& modelLevels() {
+  static const std::vector<std::string> levels{"fast", "simple", "basic", "medium", "detailed"};
+  return levels;
+}
+
+const RobotDescription& loadLevel(const std::string& level) {
+  static std::mutex mutex;
+  static std::map<std::string, std::unique_ptr<RobotDescription>> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  auto it = cache.find(level);
+  if (it != cache.end()) return *it->second;
+  bool known = false;
+  for (const auto& l : modelLevels()) known |= (l == level);
+  if (!known) {
+    throw UnknownName("unknown model level '" + level + "' (levels: fast, simple, basic, medium, detailed)");
+  }
+  const std::string dir = descriptionDirectory() + "/urdf/";
+  auto d = std::make_unique<RobotDescription>(
+      loadRobotDescription(dir + level + ".urdf", dir + level + ".sbot.yaml"));
+  return *cache.emplace(level, std::move(d)).first->second;
+}
+
+}  // namespace sbot

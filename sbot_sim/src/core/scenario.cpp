@@ -1,0 +1,279 @@
+#include "sbot_sim/core/scenario.h"
+
+#include <cmath>
+#include <fstream>
+#include <random>
+#include <set>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/robot_description.h"
+
+namespace sbot {
+namespace {
+
+// Reads typed fields of one YAML mapping and reports errors with the full dotted field path.
+class Fields {
+ public:
+  Fields(const YAML::Node& node, std::string path, const std::string& file)
+      : node_(node), path_(std::move(path)), file_(file) {
+    if (node_ && !node_.IsMap()) throw ConfigError(file_, path_, "expected a mapping");
+  }
+  std::string path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  bool has(const std::string& key) const { return node_ && node_[key]; }
+  YAML::Node node(const std::string& key) const { return node_ ? node_[key] : YAML::Node(); }
+
+  double number(const std::string& key, double fallback) const {
+    if (!has(key)) return fallback;
+    double v;
+    try {
+      v = node_[key].as<double>();
+    } catch (const YAML::Exception&) {
+      throw ConfigError(file_, path(key), "expected a number, found '" + scalar(key) + "'");
+    }
+    if (!std::isfinite(v)) throw ConfigError(file_, path(key), "must be finite");
+    return v;
+  }
+  double positive(const std::string& key, double fallback) const {
+    const double v = number(key, fallback);
+    if (!(v > 0)) throw ConfigError(file_, path(key), "must be > 0");
+    return v;
+  }
+  std::string text(const std::string& key, const std::string& fallback) const {
+    if (!has(key)) return fallback;
+    if (!node_[key].IsScalar()) throw ConfigError(file_, path(key), "expected a string");
+    return node_[key].as<std::string>();
+  }
+  bool flag(const std::string& key, bool fallback) const {
+    if (!has(key)) return fallback;
+    try {
+      return node_[key].as<bool>();
+    } catch (const YAML::Exception&) {
+      throw ConfigError(file_, path(key), "expected true or false");
+    }
+  }
+  Vec3 vec3(const std::string& key, const Vec3& fallback) const {
+    if (!has(key)) return fallback;
+    const YAML::Node n = node_[key];
+    if (!n.IsSequence() || n.size() != 3) throw ConfigError(file_, path(key), "expected [x, y, z]");
+    Vec3 v;
+    for (int i = 0; i < 3; ++i) {
+      try {
+        v[i] = n[i].as<double>();
+      } catch (const YAML::Exception&) {
+        throw ConfigError(file_, path(key), "expected three numbers");
+      }
+    }
+    return v;
+  }
+  /// Typos in scenario files should not be silently ignored.
+  void allowOnly(const std::set<std::string>& keys) const {
+    if (!node_) return;
+    for (const auto& kv : node_) {
+      const auto k = kv.first.as<std::string>();
+      if (!keys.count(k)) {
+        std::string list;
+        for (const auto& a : keys) list += (list.empty() ? "" : ", ") + a;
+        throw ConfigError(file_, path(k), "unknown field (expected one of: " + list + ")");
+      }
+    }
+  }
+
+ private:
+  std::string scalar(const std::string& key) const {
+    return node_[key].IsScalar() ? node_[key].as<std::string>() : "<not a scalar>";
+  }
+  YAML::Node node_;
+  std::string path_;
+  const std::string& file_;
+};
+
+std::string checkLevel(const std::string& level, const std::string& file, const std::string& field) {
+  for (const auto& l : modelLevels())
+    if (l == level) return level;
+  throw ConfigError(file, field, "unknown model level '" + level + "' (levels: fast, simple, basic, medium, detailed)");
+}
+
+Pose2D parsePose(const YAML::Node& n, const std::string& path, const std::string& file) {
+  Fields f(n, path, file);
+  f.allowOnly({"x", "y", "yaw"});
+  return Pose2D{f.number("x", 0), f.number("y", 0), f.number("yaw", 0)};
+}
+
+void parseTerrain(const YAML::Node& n, TerrainConfig& t, const std::string& file) {
+  Fields f(n, "world.terrain", file);
+  f.allowOnly({"type", "ground_plane", "boxes", "arena", "heightmap_image", "resolution", "size",
+               "height_range", "seed"});
+  const std::string type = f.text("type", "plane");
+  if (type == "plane") t.type = TerrainConfig::Type::Plane;
+  else if (type == "composite") t.type = TerrainConfig::Type::Composite;
+  else if (type == "rough") t.type = TerrainConfig::Type::Rough;
+  else throw ConfigError(file, f.path("type"), "expected plane, composite or rough, found '" + type + "'");
+  t.ground_plane = f.flag("ground_plane", true);
+  t.heightmap_image = f.text("heightmap_image", "");
+  if (!t.heightmap_image.empty() && t.heightmap_image[0] != '/') {
+    // Relative image paths are relative to the scenario file.
+    const auto slash = file.find_last_of('/');
+    if (slash != std::string::npos) t.heightmap_image = file.substr(0, slash + 1) + t.heightmap_image;
+  }
+  t.resolution = static_cast<int>(f.number("resolution", t.resolution));
+  if (f.has("size")) {
+    const double s = f.positive("size", 5.0);
+    t.size_x = t.size_y = s;
+  }
+  t.height_range = f.number("height_range", 0.0);
+  if (t.height_range < 0) throw ConfigError(file, f.path("height_range"), "must be >= 0");
+  t.heightmap_seed = static_cast<std::uint64_t>(f.number("seed", 1));
+
+  if (const YAML::Node boxes = f.node("boxes")) {
+    if (!boxes.IsSequence()) throw ConfigError(file, f.path("boxes"), "expected a list");
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+      Fields b(boxes[i], f.path("boxes") + "[" + std::to_string(i) + "]", file);
+      b.allowOnly({"name", "center", "size", "yaw", "pitch", "surface"});
+      BoxObstacle box;
+      box.name = b.text("name", "box_" + std::to_string(i));
+      box.center = b.vec3("center", Vec3::Zero());
+      box.size = b.vec3("size", Vec3::Ones());
+      if ((box.size.array() <= 0).any()) throw ConfigError(file, b.path("size"), "every edge must be > 0");
+      box.yaw = b.number("yaw", 0);
+      box.pitch = b.number("pitch", 0);
+      box.surface = b.text("surface", "ground");
+      t.boxes.push_back(box);
+    }
+  }
+  if (const YAML::Node arena = f.node("arena")) {
+    Fields a(arena, f.path("arena"), file);
+    a.allowOnly({"size", "height", "thickness", "surface"});
+    const double s = a.positive("size", 4.0), h = a.positive("height", 0.1), th = a.positive("thickness", 0.02);
+    const std::string surface = a.text("surface", "wall");
+    const double o = s / 2 + th / 2;
+    t.boxes.push_back({"arena_north", Vec3(0, o, h / 2), Vec3(s + 2 * th, th, h), 0, 0, surface});
+    t.boxes.push_back({"arena_south", Vec3(0, -o, h / 2), Vec3(s + 2 * th, th, h), 0, 0, surface});
+    t.boxes.push_back({"arena_east", Vec3(o, 0, h / 2), Vec3(th, s, h), 0, 0, surface});
+    t.boxes.push_back({"arena_west", Vec3(-o, 0, h / 2), Vec3(th, s, h), 0, 0, surface});
+  }
+}
+
+void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
+  Fields f(n, "world", file);
+  f.allowOnly({"step", "gravity", "solver_iterations", "solver_sor", "contact", "terrain"});
+  w.step = f.positive("step", w.step);
+  w.gravity = f.number("gravity", w.gravity);
+  w.solver_iterations = static_cast<int>(f.positive("solver_iterations", w.solver_iterations));
+  w.solver_sor = f.positive("solver_sor", w.solver_sor);
+  if (const YAML::Node c = f.node("contact")) {
+    Fields cf(c, "world.contact", file);
+    cf.allowOnly({"mu", "erp", "cfm", "bounce", "max_contacts", "coulomb", "materials"});
+    w.contact.mu = cf.number("mu", w.contact.mu);
+    if (w.contact.mu < 0) throw ConfigError(file, cf.path("mu"), "must be >= 0");
+    w.contact.erp = cf.number("erp", w.contact.erp);
+    w.contact.cfm = cf.number("cfm", w.contact.cfm);
+    w.contact.bounce = cf.number("bounce", w.contact.bounce);
+    w.contact.max_contacts = static_cast<int>(cf.positive("max_contacts", w.contact.max_contacts));
+    w.contact.coulomb = cf.flag("coulomb", w.contact.coulomb);
+    if (const YAML::Node m = cf.node("materials")) {
+      Fields mf(m, "world.contact.materials", file);
+      for (const auto& kv : m) w.contact.material_mu[kv.first.as<std::string>()] = mf.number(kv.first.as<std::string>(), 0);
+    }
+  }
+  parseTerrain(f.node("terrain"), w.terrain, file);
+}
+
+}  // namespace
+
+Scenario parseScenario(const std::string& yaml_text, const std::string& file, int robot_count) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(file, "", "not valid YAML (line " + std::to_string(e.mark.line + 1) + "): " + e.msg);
+  }
+  if (!root.IsMap()) throw ConfigError(file, "", "expected a mapping at the top level");
+  Fields f(root, "", file);
+  f.allowOnly({"seed", "duration", "world", "robots", "swarm", "name", "description", "effects"});
+  Scenario s;
+  s.source = file;
+  const double seed = f.number("seed", 1);
+  if (seed < 0 || seed != std::floor(seed)) throw ConfigError(file, "seed", "must be a non-negative integer");
+  s.world.seed = static_cast<std::uint64_t>(seed);
+  s.duration = f.number("duration", 0);
+  if (s.duration < 0) throw ConfigError(file, "duration", "must be >= 0");
+  parseWorld(f.node("world"), s.world, file);
+
+  if (const YAML::Node robots = f.node("robots")) {
+    if (!robots.IsSequence()) throw ConfigError(file, "robots", "expected a list");
+    for (std::size_t i = 0; i < robots.size(); ++i) {
+      const std::string path = "robots[" + std::to_string(i) + "]";
+      Fields r(robots[i], path, file);
+      r.allowOnly({"name", "level", "pose"});
+      RobotSpawn spawn;
+      spawn.name = r.text("name", "sbot_" + std::to_string(i));
+      spawn.level = checkLevel(r.text("level", "simple"), file, r.path("level"));
+      spawn.pose = parsePose(r.node("pose"), r.path("pose"), file);
+      s.robots.push_back(spawn);
+    }
+  }
+  if (const YAML::Node swarm = f.node("swarm")) {
+    Fields sw(swarm, "swarm", file);
+    sw.allowOnly({"count", "level", "layout", "spacing", "center", "area"});
+    const double count_d = sw.number("count", 0);
+    if (count_d < 0 || count_d != std::floor(count_d)) throw ConfigError(file, "swarm.count", "must be a non-negative integer");
+    const int count = robot_count >= 0 ? robot_count : static_cast<int>(count_d);
+    const std::string level = checkLevel(sw.text("level", "simple"), file, "swarm.level");
+    const std::string layout = sw.text("layout", "grid");
+    const double spacing = sw.positive("spacing", 0.3);
+    double cx = 0, cy = 0;
+    if (sw.has("center")) {
+      const YAML::Node c = swarm["center"];
+      if (!c.IsSequence() || c.size() != 2) throw ConfigError(file, "swarm.center", "expected [x, y]");
+      cx = c[0].as<double>();
+      cy = c[1].as<double>();
+    }
+    const int side = std::max(1, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(count)))));
+    std::mt19937_64 rng(s.world.seed * 7919 + 17);
+    const double area = sw.positive("area", side * spacing);
+    std::uniform_real_distribution<double> uni(-area / 2, area / 2), ang(-M_PI, M_PI);
+    const std::size_t first = s.robots.size();
+    for (int i = 0; i < count; ++i) {
+      RobotSpawn spawn;
+      spawn.name = "sbot_" + std::to_string(first + i);
+      spawn.level = level;
+      if (layout == "grid") {
+        spawn.pose = {cx + (i % side - (side - 1) / 2.0) * spacing, cy + (i / side - (side - 1) / 2.0) * spacing,
+                      ang(rng)};
+      } else if (layout == "random") {
+        // Rejection sampling keeps robots at least `spacing` apart.
+        for (int attempt = 0;; ++attempt) {
+          spawn.pose = {cx + uni(rng), cy + uni(rng), ang(rng)};
+          bool clear = true;
+          for (const auto& o : s.robots)
+            clear &= std::hypot(o.pose.x - spawn.pose.x, o.pose.y - spawn.pose.y) >= spacing;
+          if (clear) break;
+          if (attempt > 10000) throw ConfigError(file, "swarm.area", "too small for " + std::to_string(count) + " robots");
+        }
+      } else {
+        throw ConfigError(file, "swarm.layout", "expected grid or random, found '" + layout + "'");
+      }
+      s.robots.push_back(spawn);
+    }
+  } else if (robot_count >= 0 && static_cast<int>(s.robots.size()) > robot_count) {
+    s.robots.resize(robot_count);
+  }
+  std::set<std::string> names;
+  for (const auto& r : s.robots) {
+    if (!names.insert(r.name).second) throw ConfigError(file, "robots", "duplicate robot name '" + r.name + "'");
+  }
+  return s;
+}
+
+Scenario loadScenario(const std::string& path, int robot_count) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path, "", "cannot open scenario file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parseScenario(ss.str(), path, robot_count);
+}
+
+}  // namespace sbot

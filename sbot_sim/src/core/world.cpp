@@ -1,0 +1,265 @@
+#include "sbot_sim/core/world.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <mutex>
+
+#include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/geom_info.h"
+#include "sbot_sim/core/terrain.h"
+
+namespace sbot {
+namespace {
+
+void initOdeOnce() {
+  static std::once_flag once;
+  std::call_once(once, [] { dInitODE2(0); });
+  // Every thread that touches ODE needs its own collision scratch data (parallel simulations).
+  dAllocateODEDataForThread(dAllocateMaskAll);
+}
+
+void nearCallback(void* data, dGeomID a, dGeomID b) { static_cast<World*>(data)->handlePair(a, b); }
+
+const GeomInfo* infoOf(dGeomID g) { return static_cast<const GeomInfo*>(dGeomGetData(g)); }
+
+const std::string kGround = "ground";
+
+}  // namespace
+
+double ContactConfig::muFor(const std::string& a, const std::string& b) const {
+  auto lookup = [this](const std::string& m) {
+    auto it = material_mu.find(m);
+    return it == material_mu.end() ? mu : it->second;
+  };
+  return std::min(lookup(a), lookup(b));
+}
+
+World::World(const WorldConfig& config) : config_(config) {
+  initOdeOnce();
+  if (!(config_.step > 0)) throw ConfigError("<world>", "step", "must be > 0");
+  // A free ball in a socket transmits no tangential force: caster material is frictionless unless
+  // a scenario says otherwise.
+  config_.contact.material_mu.emplace("caster", 0.0);
+  world_ = dWorldCreate();
+  dWorldSetGravity(world_, 0, 0, -config_.gravity);
+  dWorldSetQuickStepNumIterations(world_, config_.solver_iterations);
+  dWorldSetQuickStepW(world_, config_.solver_sor);
+  dWorldSetContactSurfaceLayer(world_, 0.0005);
+  dWorldSetContactMaxCorrectingVel(world_, 0.5);
+  space_ = dHashSpaceCreate(nullptr);
+  contacts_ = dJointGroupCreate(0);
+  buildTerrain();
+}
+
+World::~World() {
+  robots_.clear();
+  for (dGeomID g : static_geoms_) {
+    delete static_cast<GeomInfo*>(dGeomGetData(g));
+    dGeomDestroy(g);
+  }
+  if (heightfield_data_) dGeomHeightfieldDataDestroy(heightfield_data_);
+  dJointGroupDestroy(contacts_);
+  dSpaceDestroy(space_);
+  dWorldDestroy(world_);
+}
+
+void World::buildTerrain() {
+  const TerrainConfig& t = config_.terrain;
+  auto addStatic = [this](dGeomID g, const std::string& material, const std::string& name) {
+    dGeomSetData(g, new GeomInfo{nullptr, material, name});
+    static_geoms_.push_back(g);
+  };
+  if (t.type != TerrainConfig::Type::Rough && t.ground_plane) {
+    addStatic(dCreatePlane(space_, 0, 0, 1, 0), kGround, "ground_plane");
+  }
+  for (const auto& box : t.boxes) {
+    dGeomID g = dCreateBox(space_, box.size.x(), box.size.y(), box.size.z());
+    dGeomSetPosition(g, box.center.x(), box.center.y(), box.center.z());
+    const Quat q = quatFromRPY(0, box.pitch, box.yaw);
+    dQuaternion oq{q.w(), q.x(), q.y(), q.z()};
+    dGeomSetQuaternion(g, oq);
+    addStatic(g, box.surface, box.name);
+  }
+  if (t.type == TerrainConfig::Type::Rough) {
+    HeightMap map = makeHeightMap(t);
+    heightfield_ = map.heights;
+    heightfield_data_ = dGeomHeightfieldDataCreate();
+    // ODE height fields are y-up; the geom is rotated so that its y axis is world z (see terrain.h).
+    dGeomHeightfieldDataBuildDouble(heightfield_data_, heightfield_.data(), 0, t.size_x, t.size_y,
+                                    map.cols, map.rows, 1.0, 0.0, 1.0, 0);
+    const double lo = *std::min_element(heightfield_.begin(), heightfield_.end());
+    const double hi = *std::max_element(heightfield_.begin(), heightfield_.end());
+    dGeomHeightfieldDataSetBounds(heightfield_data_, lo - 0.01, hi + 0.01);
+    dGeomID g = dCreateHeightfield(space_, heightfield_data_, 1);
+    dMatrix3 R;
+    dRFromAxisAndAngle(R, 1, 0, 0, M_PI / 2);
+    dGeomSetRotation(g, R);
+    addStatic(g, kGround, "rough_terrain");
+  }
+}
+
+Robot& World::addRobot(const RobotDescription& description, const Pose2D& pose, const std::string& name) {
+  Robot& r = addRobotAt(description, Pose(Vec3(pose.x, pose.y, 0), quatFromRPY(0, 0, pose.yaw)), name);
+  // Drop it onto the terrain: lowest collision point 1 mm above the highest ground below the robot.
+  double lowest = std::numeric_limits<double>::infinity();
+  double ground = -std::numeric_limits<double>::infinity();
+  for (int i = 0; i < dSpaceGetNumGeoms(r.space()); ++i) {
+    dReal aabb[6];
+    dGeomGetAABB(dSpaceGetGeom(r.space(), i), aabb);
+    lowest = std::min(lowest, static_cast<double>(aabb[4]));
+    for (double x : {aabb[0], aabb[1]})
+      for (double y : {aabb[2], aabb[3]}) ground = std::max(ground, terrainHeight(x, y));
+  }
+  ground = std::max(ground, terrainHeight(pose.x, pose.y));
+  Pose p = r.basePose();
+  p.position.z() += ground - lowest + 0.001;
+  r.setBasePose(p);
+  return r;
+}
+
+Robot& World::addRobotAt(const RobotDescription& description, const Pose& pose, const std::string& name) {
+  if (findRobot(name)) throw ConfigError("<world>", "robots", "duplicate robot name '" + name + "'");
+  robots_.push_back(std::make_unique<Robot>(*this, description, name, next_index_++, pose));
+  return *robots_.back();
+}
+
+void World::removeRobot(const std::string& name) {
+  auto it = std::find_if(robots_.begin(), robots_.end(), [&](const auto& r) { return r->name() == name; });
+  if (it == robots_.end()) throw UnknownName("unknown robot '" + name + "'");
+  robots_.erase(it);
+}
+
+Robot* World::findRobot(const std::string& name) {
+  for (auto& r : robots_)
+    if (r->name() == name) return r.get();
+  return nullptr;
+}
+
+Robot& World::robot(const std::string& name) {
+  Robot* r = findRobot(name);
+  if (!r) throw UnknownName("unknown robot '" + name + "'");
+  return *r;
+}
+
+std::vector<Robot*> World::robots() {
+  std::vector<Robot*> out;
+  for (auto& r : robots_) out.push_back(r.get());
+  return out;
+}
+
+void World::step() {
+  const double dt = config_.step;
+  for (auto& r : robots_) r->applyCommands(dt, effects_);
+  dSpaceCollide(space_, this, &nearCallback);
+  dWorldQuickStep(world_, dt);
+  dJointGroupEmpty(contacts_);
+  for (auto& r : robots_) r->readFeedback();
+  time_ += dt;
+  ++steps_;
+}
+
+void World::handlePair(dGeomID a, dGeomID b) {
+  if (dGeomIsSpace(a) || dGeomIsSpace(b)) {
+    // A robot's own space is never collided with itself: self-collision is off, like the seed.
+    dSpaceCollide2(a, b, this, &nearCallback);
+    return;
+  }
+  dBodyID ba = dGeomGetBody(a), bb = dGeomGetBody(b);
+  if (!ba && !bb) return;  // static vs static
+  if (ba && bb && dAreConnectedExcluding(ba, bb, dJointTypeContact)) return;
+  const GeomInfo* ia = infoOf(a);
+  const GeomInfo* ib = infoOf(b);
+
+  const int max_contacts = std::max(1, std::min(config_.contact.max_contacts, 16));
+  dContact contacts[16];
+  const int n = dCollide(a, b, max_contacts, &contacts[0].geom, sizeof(dContact));
+  if (n == 0) return;
+
+  ContactContext ctx;
+  ctx.robot_a = ia ? ia->robot : nullptr;
+  ctx.robot_b = ib ? ib->robot : nullptr;
+  ctx.material_a = ia ? ia->material : kGround;
+  ctx.material_b = ib ? ib->material : kGround;
+  const ContactConfig& cc = config_.contact;
+  dSurfaceParameters surface{};
+  surface.mode = dContactSoftERP | dContactSoftCFM | (cc.coulomb ? dContactApprox1 : 0) |
+                 (cc.bounce > 0 ? dContactBounce : 0);
+  surface.mu = cc.muFor(ctx.material_a, ctx.material_b);
+  surface.soft_erp = cc.erp;
+  surface.soft_cfm = cc.cfm;
+  surface.bounce = cc.bounce;
+  surface.bounce_vel = 0.05;
+  for (int i = 0; i < n; ++i) {
+    ctx.normal = Vec3(contacts[i].geom.normal[0], contacts[i].geom.normal[1], contacts[i].geom.normal[2]);
+    contacts[i].surface = surface;
+    for (const auto& e : effects_) e->onContact(ctx, contacts[i].surface);
+    dJointID c = dJointCreateContact(world_, contacts_, &contacts[i]);
+    dJointAttach(c, ba, bb);
+  }
+}
+
+namespace {
+
+struct RayQuery {
+  const Robot* ignore;
+  RayHit* best;
+};
+
+// Test the ray against one geom and keep the nearest hit.
+void rayAgainstGeom(RayQuery& q, dGeomID ray, dGeomID other) {
+  const GeomInfo* gi = infoOf(other);
+  if (gi && q.ignore && gi->robot == q.ignore) return;  // a sensor does not see its own robot
+  dContactGeom c;
+  if (dCollide(ray, other, 1, &c, sizeof(c)) != 1 || c.depth >= q.best->distance) return;
+  RayHit& b = *q.best;
+  b.hit = true;
+  b.distance = c.depth;
+  b.point = Vec3(c.pos[0], c.pos[1], c.pos[2]);
+  b.normal = Vec3(c.normal[0], c.normal[1], c.normal[2]);
+  b.surface = gi ? gi->material : kGround;
+  b.robot = gi ? gi->robot : nullptr;
+}
+
+void rayCallback(void* data, dGeomID o1, dGeomID o2) {
+  auto& q = *static_cast<RayQuery*>(data);
+  if (dGeomIsSpace(o1) || dGeomIsSpace(o2)) {
+    dSpaceCollide2(o1, o2, data, &rayCallback);  // descend into a robot's space
+    return;
+  }
+  const bool first_is_ray = dGeomGetClass(o1) == dRayClass;
+  rayAgainstGeom(q, first_is_ray ? o1 : o2, first_is_ray ? o2 : o1);
+}
+
+}  // namespace
+
+RayHit World::castRay(const Vec3& origin, const Vec3& direction, double length, const Robot* ignore) const {
+  RayHit best;
+  best.distance = length;
+  dGeomID ray = dCreateRay(nullptr, length);
+  const Vec3 d = direction.normalized();
+  dGeomRaySet(ray, origin.x(), origin.y(), origin.z(), d.x(), d.y(), d.z());
+  dGeomRaySetClosestHit(ray, 1);
+  RayQuery query{ignore, &best};
+  dSpaceCollide2(ray, reinterpret_cast<dGeomID>(space_), &query, &rayCallback);
+  dGeomDestroy(ray);
+  return best;
+}
+
+double World::terrainHeight(double x, double y) const {
+  // Cast down against static geometry only: handles planes, tilted boxes and height fields alike.
+  double best = config_.terrain.type == TerrainConfig::Type::Rough || !config_.terrain.ground_plane
+                    ? -std::numeric_limits<double>::infinity()
+                    : 0.0;
+  constexpr double kTop = 100.0;
+  dGeomID ray = dCreateRay(nullptr, 2 * kTop);
+  dGeomRaySet(ray, x, y, kTop, 0, 0, -1);
+  for (dGeomID g : static_geoms_) {
+    dContactGeom c;
+    if (dCollide(ray, g, 1, &c, sizeof(c)) == 1) best = std::max(best, kTop - c.depth);
+  }
+  dGeomDestroy(ray);
+  return std::isfinite(best) ? best : 0.0;
+}
+
+}  // namespace sbot

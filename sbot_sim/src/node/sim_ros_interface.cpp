@@ -1,0 +1,351 @@
+#include "sim_ros_interface.h"
+
+#include <cmath>
+#include <sstream>
+#include <thread>
+
+#include <ros/callback_queue.h>
+#include <rosgraph_msgs/Clock.h>
+
+#include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/robot_description.h"
+
+namespace sbot_node {
+
+namespace {
+
+using SteadyClock = std::chrono::steady_clock;
+
+double secondsSince(SteadyClock::time_point t) {
+  return std::chrono::duration<double>(SteadyClock::now() - t).count();
+}
+
+/// If the loop falls this far behind the requested real-time factor (slow machine, debugger, a
+/// blocking service), it re-anchors instead of racing to catch up. [s wall]
+constexpr double kMaxPacingLag = 0.25;
+
+}  // namespace
+
+SimRosInterface::SimRosInterface() : pnh_("~") {}
+
+SimRosInterface::~SimRosInterface() {
+  // Interfaces hold pointers into the world: drop them first.
+  robots_.clear();
+  world_.reset();
+}
+
+bool SimRosInterface::readParams() {
+  bool ok = true;
+  if (!pnh_.getParam("scenario", params_.scenario) || params_.scenario.empty()) {
+    ROS_FATAL("simulator: private parameter ~scenario (path of the scenario YAML) is required, e.g. "
+              "_scenario:=$(rospack find swarmbot3d)/config/scenarios/flat_swarm.yaml");
+    return false;
+  }
+  pnh_.param("robots", params_.robots, -1);
+  pnh_.param("real_time_factor", params_.real_time_factor, 1.0);
+  pnh_.param("duration", params_.duration, 0.0);
+  pnh_.param("publish_rate", params_.publish_rate, 50.0);
+  pnh_.param("paused", params_.paused, false);
+  pnh_.param("set_description_params", params_.set_description_params, false);
+  ROS_INFO("simulator: ~scenario=%s ~robots=%d ~real_time_factor=%g ~duration=%g ~publish_rate=%g ~paused=%s "
+           "~set_description_params=%s", params_.scenario.c_str(), params_.robots, params_.real_time_factor,
+           params_.duration, params_.publish_rate, params_.paused ? "true" : "false",
+           params_.set_description_params ? "true" : "false");
+  if (params_.robots < -1) {
+    ROS_FATAL("simulator: ~robots must be -1 (the scenario's count) or >= 0, got %d", params_.robots);
+    ok = false;
+  }
+  if (!std::isfinite(params_.real_time_factor) || params_.real_time_factor < 0) {
+    ROS_FATAL("simulator: ~real_time_factor must be >= 0 (0 = as fast as possible), got %g",
+              params_.real_time_factor);
+    ok = false;
+  }
+  if (!std::isfinite(params_.duration) || params_.duration < 0) {
+    ROS_FATAL("simulator: ~duration must be >= 0 s (0 = the scenario's), got %g", params_.duration);
+    ok = false;
+  }
+  if (!std::isfinite(params_.publish_rate) || params_.publish_rate <= 0) {
+    ROS_FATAL("simulator: ~publish_rate must be > 0 Hz, got %g", params_.publish_rate);
+    ok = false;
+  }
+  return ok;
+}
+
+bool SimRosInterface::init() {
+  if (!readParams()) return false;
+  try {
+    scenario_ = sbot::loadScenario(params_.scenario, params_.robots);
+    world_ = buildWorld();
+  } catch (const sbot::ConfigError& e) {
+    ROS_FATAL("simulator: %s", e.what());
+    return false;
+  } catch (const std::exception& e) {
+    ROS_FATAL("simulator: cannot load scenario %s: %s", params_.scenario.c_str(), e.what());
+    return false;
+  }
+  end_time_ = params_.duration > 0 ? params_.duration : scenario_.duration;
+  paused_ = params_.paused;
+
+  // Every node started after this one follows /clock (the launch files set it too).
+  ros::param::set("/use_sim_time", true);
+
+  clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
+  for (sbot::Robot* r : world_->robots()) robots_.push_back(std::make_unique<RobotRosInterface>(nh_, *r, params_.set_description_params));
+
+  ros::NodeHandle sim(nh_, "sim");
+  pause_srv_ = sim.advertiseService("pause", &SimRosInterface::onPause, this);
+  unpause_srv_ = sim.advertiseService("unpause", &SimRosInterface::onUnpause, this);
+  reset_srv_ = sim.advertiseService("reset", &SimRosInterface::onReset, this);
+  step_srv_ = sim.advertiseService("step", &SimRosInterface::onStep, this);
+  set_pose_srv_ = sim.advertiseService("set_pose", &SimRosInterface::onSetPose, this);
+
+  const double dt = world_->config().step;
+  ROS_INFO("simulator: scenario %s: %zu robots (%s), step %g s, seed %llu, duration %s%s",
+           scenario_.source.c_str(), world_->robotCount(), robotList().c_str(), dt,
+           static_cast<unsigned long long>(world_->config().seed),
+           end_time_ > 0 ? (std::to_string(end_time_) + " s").c_str() : "unlimited",
+           paused_ ? "; starting paused (call /sim/unpause or /sim/step)" : "");
+  if (params_.publish_rate * dt > 1.0 + 1e-9)
+    ROS_WARN("simulator: ~publish_rate %g Hz exceeds the step rate %g Hz: publishing every step",
+             params_.publish_rate, 1.0 / dt);
+  return true;
+}
+
+std::unique_ptr<sbot::World> SimRosInterface::buildWorld() const {
+  auto world = std::make_unique<sbot::World>(scenario_.world);
+  for (const sbot::RobotSpawn& s : scenario_.robots)
+    world->addRobot(sbot::loadLevel(s.level), s.pose, s.name);
+  return world;
+}
+
+void SimRosInterface::publishClock() {
+  rosgraph_msgs::Clock c;
+  c.clock = stamp();
+  clock_pub_.publish(c);
+}
+
+void SimRosInterface::publishStates() {
+  // Publish on every step that crosses a multiple of 1/publish_rate: the average rate is exact even
+  // when the step rate is not a multiple of it.
+  const double dt = world_->config().step;
+  const auto tick = static_cast<std::int64_t>(std::floor(static_cast<double>(total_steps_) * dt *
+                                                         params_.publish_rate + 1e-6));
+  if (tick == last_publish_tick_) return;
+  last_publish_tick_ = tick;
+  const ros::Time t = stamp();
+  std::vector<geometry_msgs::TransformStamped> transforms;
+  transforms.reserve(robots_.size());
+  for (auto& r : robots_) r->publishState(t, transforms);
+  if (!transforms.empty()) tf_broadcaster_->sendTransform(transforms);
+}
+
+void SimRosInterface::stepOnce() {
+  world_->step();
+  ++total_steps_;
+  publishClock();
+  publishStates();
+}
+
+bool SimRosInterface::durationReached() const {
+  return end_time_ > 0 && simTime() >= end_time_ - 1e-9;
+}
+
+void SimRosInterface::resetPacing() {
+  pace_wall_ = SteadyClock::now();
+  pace_sim_ = simTime();
+}
+
+double SimRosInterface::wallUntilNextStep() {
+  if (params_.real_time_factor <= 0) return 0;
+  // The step that brings the clock to simTime() + dt is due when the wall clock, scaled by the
+  // real-time factor, gets there: /clock never runs ahead of rtf x wall time.
+  const double next = simTime() + world_->config().step - pace_sim_;
+  const double wait = next / params_.real_time_factor - secondsSince(pace_wall_);
+  if (wait < -kMaxPacingLag) {
+    resetPacing();
+    return 0;
+  }
+  return wait;
+}
+
+int SimRosInterface::run() {
+  ros::CallbackQueue* queue = ros::getGlobalCallbackQueue();
+  run_start_ = SteadyClock::now();
+  run_start_sim_ = simTime();
+  resetPacing();
+  std::string reason = "shutdown requested";
+  while (ros::ok()) {
+    if (!world_) {
+      logSummary("no world after a failed reset");
+      return 1;
+    }
+    if (durationReached()) {
+      reason = "duration reached";
+      break;
+    }
+    if (paused_) {
+      // Services (unpause, step, reset, set_pose) and commands are served while paused.
+      queue->callAvailable(ros::WallDuration(0.05));
+      resetPacing();
+      continue;
+    }
+    const double wait = wallUntilNextStep();
+    if (wait > 1e-6) {
+      // Serve callbacks while waiting; loop again to re-check the pause flag and the deadline.
+      queue->callAvailable(ros::WallDuration(std::min(wait, 0.05)));
+      continue;
+    }
+    queue->callAvailable();  // commands received so far apply at this step
+    if (paused_ || !ros::ok()) continue;
+    try {
+      stepOnce();
+    } catch (const std::exception& e) {
+      ROS_FATAL("simulator: step %llu at t=%.3f s failed: %s",
+                static_cast<unsigned long long>(world_->stepCount()), simTime(), e.what());
+      logSummary("error");
+      return 1;
+    }
+  }
+  logSummary(reason);
+  return 0;
+}
+
+void SimRosInterface::logSummary(const std::string& reason) const {
+  const double wall = secondsSince(run_start_);
+  const double sim = (world_ ? simTime() : time_offset_) - run_start_sim_;
+  ROS_INFO("simulator: %s: sim time %.3f s, wall time %.3f s, RTM %.3f, robots %zu, steps %llu, resets %llu",
+           reason.c_str(), sim, wall, wall > 0 ? sim / wall : 0.0, robots_.size(),
+           static_cast<unsigned long long>(total_steps_), static_cast<unsigned long long>(reset_count_));
+}
+
+std::string SimRosInterface::robotList() const {
+  std::vector<std::string> names;
+  for (const auto& r : robots_) names.push_back(r->name());
+  if (names.empty()) return "none";
+  bool canonical = names.size() > 1;
+  for (std::size_t i = 0; canonical && i < names.size(); ++i)
+    canonical = names[i] == "sbot_" + std::to_string(i);
+  if (canonical) return names.front() + ".." + names.back();
+  std::ostringstream out;
+  const std::size_t shown = std::min<std::size_t>(names.size(), 10);
+  for (std::size_t i = 0; i < shown; ++i) out << (i ? ", " : "") << names[i];
+  if (shown < names.size()) out << ", ... (" << names.size() << " robots)";
+  return out.str();
+}
+
+// ---- services ---------------------------------------------------------------------------------
+
+bool SimRosInterface::onPause(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  res.success = true;
+  res.message = std::string(paused_ ? "already paused" : "paused") + " at t=" + std::to_string(simTime()) + " s";
+  if (!paused_) ROS_INFO("simulator: paused at t=%.3f s", simTime());
+  paused_ = true;
+  return true;
+}
+
+bool SimRosInterface::onUnpause(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  res.success = true;
+  res.message = std::string(paused_ ? "running" : "already running") + " from t=" + std::to_string(simTime()) + " s";
+  if (paused_) ROS_INFO("simulator: running from t=%.3f s", simTime());
+  paused_ = false;
+  resetPacing();
+  return true;
+}
+
+bool SimRosInterface::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  if (!world_) {
+    res.success = false;
+    res.message = "no world (a previous reset failed)";
+    return true;
+  }
+  const double before = simTime();
+  try {
+    // Resolve every level first (cached), so a failure leaves the running world untouched.
+    for (const sbot::RobotSpawn& s : scenario_.robots) sbot::loadLevel(s.level);
+    // Tear the old world down before building the new one (one ODE world at a time).
+    for (auto& iface : robots_) iface->unbind();
+    world_.reset();
+    // The rebuilt world starts at 0; ROS time continues one step later so stamps stay increasing.
+    time_offset_ = before + scenario_.world.step;
+    ++total_steps_;
+    world_ = buildWorld();
+  } catch (const std::exception& e) {
+    ROS_FATAL("simulator: /sim/reset failed to rebuild the world: %s", e.what());
+    res.success = false;
+    res.message = std::string("reset failed: ") + e.what();
+    world_.reset();  // the old world is gone: run() exits with an error
+    return true;
+  }
+  for (auto& iface : robots_) {
+    sbot::Robot* r = world_->findRobot(iface->name());
+    if (r) iface->bind(*r);
+  }
+  ++reset_count_;
+  last_publish_tick_ = -1;  // publish the initial state now
+  publishClock();
+  publishStates();
+  resetPacing();
+  res.success = true;
+  res.message = "world rebuilt from " + scenario_.source + " (seed " +
+                std::to_string(scenario_.world.seed) + "); ROS time continues at " +
+                std::to_string(simTime()) + " s";
+  ROS_INFO("simulator: reset at t=%.3f s: %s", before, res.message.c_str());
+  return true;
+}
+
+bool SimRosInterface::onStep(sbot_msgs::Step::Request& req, sbot_msgs::Step::Response& res) {
+  if (!world_) {
+    res.success = false;
+    res.message = "no world (a reset failed)";
+    return true;
+  }
+  res.time = simTime();
+  if (!paused_) {
+    res.success = false;
+    res.message = "the simulation is running: call /sim/pause before /sim/step";
+    return true;
+  }
+  try {
+    std::uint32_t done = 0;
+    for (; done < req.steps && !durationReached() && ros::ok(); ++done) stepOnce();
+    res.success = true;
+    if (done < req.steps)
+      res.message = "stopped after " + std::to_string(done) + " of " + std::to_string(req.steps) +
+                    " steps: " + (durationReached() ? "duration reached" : "shutting down");
+  } catch (const std::exception& e) {
+    res.success = false;
+    res.message = std::string("step failed: ") + e.what();
+  }
+  res.time = simTime();
+  return true;
+}
+
+bool SimRosInterface::onSetPose(sbot_msgs::SetPose::Request& req, sbot_msgs::SetPose::Response& res) {
+  res.success = false;
+  if (!world_) {
+    res.message = "no world (a reset failed)";
+    return true;
+  }
+  sbot::Robot* robot = world_->findRobot(req.robot);
+  if (!robot) {
+    res.message = "unknown robot '" + req.robot + "' (robots: " + robotList() + ")";
+    return true;
+  }
+  const std::pair<const char*, double> fields[] = {{"x", req.x}, {"y", req.y}, {"z", req.z}, {"yaw", req.yaw}};
+  for (const auto& f : fields) {
+    if (!std::isfinite(f.second)) {
+      res.message = std::string("field ") + f.first + " is not finite (" + std::to_string(f.second) + ")";
+      return true;
+    }
+  }
+  try {
+    robot->setBasePose(sbot::Pose(sbot::Vec3(req.x, req.y, req.z), sbot::quatFromRPY(0, 0, req.yaw)));
+    res.success = true;
+  } catch (const std::exception& e) {
+    res.message = e.what();
+  }
+  return true;
+}
+
+}  // namespace sbot_node
