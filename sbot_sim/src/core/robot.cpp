@@ -156,11 +156,14 @@ void Robot::build(const Pose& base_pose) {
     const Vec3 axis = w.orientation * j.axis;
     dJointSetHingeAnchor(h.id, w.position.x(), w.position.y(), w.position.z());
     dJointSetHingeAxis(h.id, axis.x(), axis.y(), axis.z());
-    if (j.type == JointDescription::Type::Revolute) {
+    // ODE hinge stops work within [-pi, pi]; wider ranges (the turret's +-200 deg) are kept by the
+    // joint's servo instead.
+    if (j.type == JointDescription::Type::Revolute && j.lower >= -M_PI && j.upper <= M_PI) {
       dJointSetHingeParam(h.id, dParamLoStop, j.lower);
       dJointSetHingeParam(h.id, dParamHiStop, j.upper);
     }
     dJointSetHingeParam(h.id, dParamFMax, 0);  // passive until a module drives it
+    dJointSetHingeParam(h.id, dParamCFM, 1e-10);  // stiff motor: a held joint must not creep
     hinge_index_[j.name] = static_cast<int>(hinges_.size());
     hinges_.push_back(h);
   }
@@ -169,6 +172,29 @@ void Robot::build(const Pose& base_pose) {
   for (const auto& jn : d.treels.left_joints) left_hinges_.push_back(hinge_index_.at(jn));
   for (const auto& jn : d.treels.right_joints) right_hinges_.push_back(hinge_index_.at(jn));
   if (!d.turret.joint.empty()) turret_hinge_ = hinge_index_.at(d.turret.joint);
+  addReflectedRotorInertia(left_hinges_);
+  addReflectedRotorInertia(right_hinges_);
+}
+
+void Robot::addReflectedRotorInertia(const std::vector<int>& track) {
+  // The motor's rotor turns gear_ratio times faster than the axle, so at the axle it weighs
+  // rotor_inertia * gear_ratio^2 — far more than the wheels themselves. Each wheel of the track
+  // carries an equal share about its own axis.
+  const TreelsSemantics& tr = description_->treels;
+  if (track.empty() || tr.rotor_inertia <= 0) return;
+  const double share = tr.rotor_inertia * tr.gear_ratio * tr.gear_ratio / track.size();
+  for (int i : track) {
+    dBodyID body = bodies_[hinges_[i].child_body];
+    dMass m;
+    dBodyGetMass(body, &m);
+    const Vec3& a = hinges_[i].axis_in_child;  // child link frame == body frame orientation
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) m.I[r * 4 + c] += share * a[r] * a[c];
+    dBodySetMass(body, &m);
+    // That inertia spins at the rotor's speed, not the wheel's: its gyroscopic torque is
+    // gear_ratio times smaller than ODE would compute for the wheel body, i.e. negligible.
+    dBodySetGyroscopicMode(body, 0);
+  }
 }
 
 const Robot::Hinge* Robot::hinge(const std::string& joint) const {
@@ -177,11 +203,12 @@ const Robot::Hinge* Robot::hinge(const std::string& joint) const {
 }
 
 double Robot::hingeRate(const Hinge& h) const { return dJointGetHingeAngleRate(h.id); }
-double Robot::hingeAngle(const Hinge& h) const { return dJointGetHingeAngle(h.id); }
+double Robot::hingeAngle(const Hinge& h) const { return h.angle; }
 
 // ---- s-bot API ---------------------------------------------------------------------------------
 
 bool Robot::setSpeed(int left, int right) {
+  passive_ = false;
   const int limit = description_->treels.speed_limit_units;
   const int l = clampInt(clampInt(left, -kApiLimit, kApiLimit), -limit, limit);
   const int r = clampInt(clampInt(right, -kApiLimit, kApiLimit), -limit, limit);
@@ -191,6 +218,7 @@ bool Robot::setSpeed(int left, int right) {
 }
 
 void Robot::setTrackSpeeds(double left_mps, double right_mps) {
+  passive_ = false;
   const double vmax = description_->treels.speed_limit_units * description_->treels.speed_unit;
   auto limit = [vmax](double v) { return std::isfinite(v) ? std::max(-vmax, std::min(vmax, v)) : 0.0; };
   req_left_ = limit(left_mps);
@@ -302,8 +330,16 @@ void Robot::applyCommands(double dt, const std::vector<EffectPtr>& effects) {
       dJointSetHingeParam(h.id, dParamFMax, share);
     }
   };
-  drive(left_hinges_, cmd.left, cmd.max_torque_left);
-  drive(right_hinges_, cmd.right, cmd.max_torque_right);
+  if (passive_) {
+    // Motors off: the gears resist rolling with back-drive friction; pulling the robot takes
+    // backdrive_force in total, half of it on each track.
+    const double holding = 0.5 * tr.backdrive_force * tr.wheel_radius;  // [N m] per track
+    drive(left_hinges_, 0.0, holding);
+    drive(right_hinges_, 0.0, holding);
+  } else {
+    drive(left_hinges_, cmd.left, cmd.max_torque_left);
+    drive(right_hinges_, cmd.right, cmd.max_torque_right);
+  }
 
   if (turret_hinge_ >= 0) {
     // Position servo (the turret's PIC controller): proportional velocity demand capped at the
@@ -319,6 +355,9 @@ void Robot::applyCommands(double dt, const std::vector<EffectPtr>& effects) {
 
 void Robot::readFeedback() {
   for (auto& h : hinges_) {
+    const double raw = dJointGetHingeAngle(h.id);
+    h.angle += std::remainder(raw - h.raw_angle, 2 * M_PI);
+    h.raw_angle = raw;
     // Torque the joint applied to the child body about the joint axis (motor + limit stops). The
     // child's centre of mass lies on or near the axis, so the constraint force adds ~nothing.
     dVector3 a;

@@ -144,6 +144,10 @@ void parseSidecar(RobotDescription& d) {
   tr.torque_unit = get<double>(t, "torque_unit", tr.torque_unit, file, "treels.");
   tr.speed_unit = get<double>(t, "speed_unit", tr.speed_unit, file, "treels.");
   tr.speed_limit_units = get<int>(t, "speed_limit_units", tr.speed_limit_units, file, "treels.");
+  tr.gear_ratio = get<double>(t, "gear_ratio", tr.gear_ratio, file, "treels.");
+  tr.rotor_inertia = get<double>(t, "rotor_inertia", tr.rotor_inertia, file, "treels.");
+  tr.backdrive_force = get<double>(t, "backdrive_force", tr.backdrive_force, file, "treels.");
+  if (tr.rotor_inertia < 0) throw ConfigError(file, "treels.rotor_inertia", "must be >= 0");
   if (tr.left_joints.empty() || tr.right_joints.empty())
     throw ConfigError(file, "treels.left_joints/right_joints", "each track needs at least one driven joint");
   if (!(tr.wheel_radius > 0)) throw ConfigError(file, "treels.wheel_radius", "must be > 0");

@@ -17,13 +17,16 @@ namespace {
 // Reads typed fields of one YAML mapping and reports errors with the full dotted field path.
 class Fields {
  public:
+  // An absent or empty (null) section reads as all defaults.
   Fields(const YAML::Node& node, std::string path, const std::string& file)
-      : node_(node), path_(std::move(path)), file_(file) {
-    if (node_ && !node_.IsMap()) throw ConfigError(file_, path_, "expected a mapping");
+      : node_(node), present_(node.IsDefined() && !node.IsNull()), path_(std::move(path)), file_(file) {
+    if (present_ && !node_.IsMap()) throw ConfigError(file_, path_, "expected a mapping");
   }
   std::string path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
-  bool has(const std::string& key) const { return node_ && node_[key]; }
-  YAML::Node node(const std::string& key) const { return node_ ? node_[key] : YAML::Node(); }
+  bool has(const std::string& key) const { return present_ && node_[key] && !node_[key].IsNull(); }
+  YAML::Node node(const std::string& key) const {
+    return has(key) ? node_[key] : YAML::Node(YAML::NodeType::Undefined);
+  }
 
   double number(const std::string& key, double fallback) const {
     if (!has(key)) return fallback;
@@ -70,7 +73,7 @@ class Fields {
   }
   /// Typos in scenario files should not be silently ignored.
   void allowOnly(const std::set<std::string>& keys) const {
-    if (!node_) return;
+    if (!present_) return;
     for (const auto& kv : node_) {
       const auto k = kv.first.as<std::string>();
       if (!keys.count(k)) {
@@ -86,6 +89,7 @@ class Fields {
     return node_[key].IsScalar() ? node_[key].as<std::string>() : "<not a scalar>";
   }
   YAML::Node node_;
+  bool present_;
   std::string path_;
   const std::string& file_;
 };

@@ -7,6 +7,7 @@
 
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/geom_info.h"
+#include "sbot_sim/core/random_streams.h"
 #include "sbot_sim/core/terrain.h"
 
 namespace sbot {
@@ -28,19 +29,19 @@ const std::string kGround = "ground";
 }  // namespace
 
 double ContactConfig::muFor(const std::string& a, const std::string& b) const {
-  auto lookup = [this](const std::string& m) {
-    auto it = material_mu.find(m);
-    return it == material_mu.end() ? mu : it->second;
-  };
-  return std::min(lookup(a), lookup(b));
+  // A material with its own coefficient overrides the default surface; two such materials in
+  // contact use the lower of the two.
+  auto ia = material_mu.find(a), ib = material_mu.find(b);
+  if (ia == material_mu.end() && ib == material_mu.end()) return mu;
+  if (ia == material_mu.end()) return ib->second;
+  if (ib == material_mu.end()) return ia->second;
+  return std::min(ia->second, ib->second);
 }
 
 World::World(const WorldConfig& config) : config_(config) {
   initOdeOnce();
   if (!(config_.step > 0)) throw ConfigError("<world>", "step", "must be > 0");
-  // A free ball in a socket transmits no tangential force: caster material is frictionless unless
-  // a scenario says otherwise.
-  config_.contact.material_mu.emplace("caster", 0.0);
+
   world_ = dWorldCreate();
   dWorldSetGravity(world_, 0, 0, -config_.gravity);
   dWorldSetQuickStepNumIterations(world_, config_.solver_iterations);
@@ -152,6 +153,10 @@ void World::step() {
   const double dt = config_.step;
   for (auto& r : robots_) r->applyCommands(dt, effects_);
   dSpaceCollide(space_, this, &nearCallback);
+  // QuickStep shuffles constraints with ODE's one global generator; reseeding it from the step
+  // count makes every run of a scenario bit-identical whatever other worlds did in this process.
+  // (Worlds in parallel threads would share that generator: run parallel simulations as processes.)
+  dRandSetSeed(static_cast<unsigned long>(stableHash(config_.seed, std::to_string(steps_))));
   dWorldQuickStep(world_, dt);
   dJointGroupEmpty(contacts_);
   for (auto& r : robots_) r->readFeedback();
@@ -190,10 +195,17 @@ void World::handlePair(dGeomID a, dGeomID b) {
   surface.soft_cfm = cc.cfm;
   surface.bounce = cc.bounce;
   surface.bounce_vel = 0.05;
+  const Robot* mover = ctx.robot_a ? ctx.robot_a : ctx.robot_b;
+  const Vec3 heading = mover ? Vec3(mover->basePose().orientation * Vec3::UnitX()) : Vec3::Zero();
   for (int i = 0; i < n; ++i) {
     ctx.normal = Vec3(contacts[i].geom.normal[0], contacts[i].geom.normal[1], contacts[i].geom.normal[2]);
+    const Vec3 along = heading - heading.dot(ctx.normal) * ctx.normal;
+    ctx.fdir1 = along.norm() > 1e-9 ? Vec3(along.normalized()) : Vec3::Zero();
     contacts[i].surface = surface;
     for (const auto& e : effects_) e->onContact(ctx, contacts[i].surface);
+    if (contacts[i].surface.mode & dContactFDir1) {
+      for (int k = 0; k < 3; ++k) contacts[i].fdir1[k] = ctx.fdir1[k];
+    }
     dJointID c = dJointCreateContact(world_, contacts_, &contacts[i]);
     dJointAttach(c, ba, bb);
   }

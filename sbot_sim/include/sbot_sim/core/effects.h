@@ -30,6 +30,10 @@ struct ContactContext {
   const Robot* robot_b = nullptr;
   std::string material_a, material_b;
   Vec3 normal = Vec3::UnitZ();          ///< from b to a
+  /// First friction direction for anisotropic friction: the heading of the robot involved,
+  /// projected on the contact plane (zero when no robot is involved). An effect that sets
+  /// dContactFDir1 in surface.mode gets it copied into the contact.
+  Vec3 fdir1 = Vec3::Zero();
 };
 
 /// One raw sensor value before it is converted to API units.

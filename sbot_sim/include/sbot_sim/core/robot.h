@@ -49,6 +49,10 @@ class Robot {
   void getSpeed(int* left, int* right) const;
   /// Motor torques applied last step, API units (2.4412 mN m), in [-127,127].
   void getTrackTorque(int* left, int* right) const;
+  /// Passive treels (seed TreelsModule::setPassive): motors off, only the gear back-drive friction
+  /// (treels.backdrive_force) resists rolling. Any setSpeed() makes them active again.
+  void setTracksPassive(bool passive) { passive_ = passive; }
+  bool tracksPassive() const { return passive_; }
   /// Turret position target in API units of 2 degrees, clamped to [-100,100]. Returns true if clamped.
   bool setTurretRotation(int pos);
   int getTurretRotation() const;
@@ -99,9 +103,12 @@ class Robot {
     Vec3 axis_in_child = Vec3::UnitZ();
     int child_body = -1;
     double effort = 0;      ///< torque about the axis, last step [N m]
+    double angle = 0;       ///< unwrapped angle [rad]: ODE reports [-pi, pi], the turret turns +-200 deg
+    double raw_angle = 0;   ///< ODE's wrapped angle at the last update
   };
 
   void build(const Pose& base_pose);
+  void addReflectedRotorInertia(const std::vector<int>& track);
   const Hinge* hinge(const std::string& joint) const;
   double hingeRate(const Hinge& h) const;
   double hingeAngle(const Hinge& h) const;
@@ -125,6 +132,7 @@ class Robot {
 
   double req_left_ = 0, req_right_ = 0;  ///< requested track speeds [m/s]
   double turret_target_ = 0;             ///< [rad]
+  bool passive_ = false;
 };
 
 }  // namespace sbot

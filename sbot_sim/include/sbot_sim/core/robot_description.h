@@ -52,6 +52,9 @@ struct TreelsSemantics {
   double torque_unit = 0.0024412;    ///< [N m] per API torque unit
   double speed_unit = 0.0028;        ///< [m/s] per API speed unit
   int speed_limit_units = 70;        ///< simulator limit (seed 2.2.1); API range is [-127,127]
+  double gear_ratio = 150;           ///< motor to axle
+  double rotor_inertia = 0;          ///< [kg m^2] of one track motor's rotor (reflected: x gear^2)
+  double backdrive_force = 1.2;      ///< [N] to pull the whole robot with its motors off (passive)
 };
 
 /// Turret servo. Table 2.3.

@@ -13,11 +13,18 @@ namespace sbot {
 
 /// Contact model. Materials are named by the sidecar (`materials`) and by obstacles (`surface`).
 struct ContactConfig {
-  /// Coulomb friction coefficient used for any material without its own entry. The s-bot's rubber
-  /// treels on the seed's polystyrene must hold a 30 degree slope until they topple (Table 4.1), which
-  /// needs mu >= tan(30 deg) = 0.58; we use 1.0. See README "Friction" for the 1.2 N traction figure.
-  double mu = 1.0;
-  std::map<std::string, double> material_mu;  ///< per-material coefficient; a pair uses the smaller
+  /// Coulomb coefficient of any contact without a listed material: the s-bot's plastic turret and
+  /// chassis against walls, obstacles and other robots (0.4, plastic on plastic/painted wood). The
+  /// treels have their own entry below; with 1.0 here a robot pushing a wall climbs it with its
+  /// turret and flips over backwards.
+  double mu = 0.4;
+  /// Per-material coefficients; they override `mu` (two listed materials: the smaller wins).
+  ///  caster 0   a free ball in a socket transmits no tangential force.
+  ///  track  1.0 rubber treels on the seed's polystyrene/wood: holds a 30 deg slope until the robot
+  ///             topples (Table 4.1 needs mu >= tan 30 deg = 0.58). Note the motors (0.22 N m per
+  ///             track = 10 N at the ground) are far stronger than this traction (6.5 N for the whole
+  ///             robot): a robot pushing a wall slips its tracks rather than stalling its motors.
+  std::map<std::string, double> material_mu{{"caster", 0.0}, {"track", 1.0}};
   double erp = 0.2;         ///< contact error reduction (ODE soft_erp)
   double cfm = 1e-5;        ///< contact softness (ODE soft_cfm) [m/N scaled by step]
   double bounce = 0.0;      ///< restitution

@@ -1,0 +1,40 @@
+// Effects files: which library effects are switched on, with which parameters. Written by
+// `sbot_calibrate fit`, read by the calibration workbench, the simulator node and scenarios.
+//
+//   format: sbot-effects/1          # optional
+//   effects:
+//     - name: speed_scale           # a registered effect (effect_registry.h)
+//       params: {scale: 1.04}       # missing parameters take their null value (effect off)
+//       stderr: {scale: 0.002}      # optional, informational (standard errors from a fit)
+//       note: "fitted on datasets/example"   # optional
+//
+// Every error is an sbot::ConfigError naming the file and the field (e.g. effects[1].params.scale).
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "sbot_sim/core/effects.h"
+
+namespace sbot {
+
+struct EffectConfig {
+  std::string name;
+  std::map<std::string, double> params;
+  std::map<std::string, double> stderr_;  ///< optional standard errors (same keys as params)
+  std::string note;
+};
+
+std::vector<EffectConfig> parseEffectsConfig(const std::string& yaml_text, const std::string& source);
+std::vector<EffectConfig> loadEffectsConfig(const std::string& path);
+/// Validate (names, parameters, bounds) and instantiate.
+std::vector<EffectPtr> makeEffects(const std::vector<EffectConfig>& configs, const std::string& source = "<effects>");
+/// Read, validate and instantiate an effects file.
+std::vector<EffectPtr> loadEffectsFile(const std::string& path);
+
+std::string effectsToYaml(const std::vector<EffectConfig>& configs, const std::string& header_comment = "");
+void writeEffectsFile(const std::string& path, const std::vector<EffectConfig>& configs,
+                      const std::string& header_comment = "");
+
+}  // namespace sbot
