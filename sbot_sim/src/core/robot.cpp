@@ -163,7 +163,6 @@ void Robot::build(const Pose& base_pose) {
       dJointSetHingeParam(h.id, dParamHiStop, j.upper);
     }
     dJointSetHingeParam(h.id, dParamFMax, 0);  // passive until a module drives it
-    dJointSetHingeParam(h.id, dParamCFM, 1e-10);  // stiff motor: a held joint must not creep
     hinge_index_[j.name] = static_cast<int>(hinges_.size());
     hinges_.push_back(h);
   }

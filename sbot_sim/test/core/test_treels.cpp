@@ -125,9 +125,14 @@ TEST(Treels, HeldTracksStallAtMaximumTorque) {
   Robot& f = free_world.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_0");
   f.setSpeed(50, 50);
   runFor(free_world, 3.0);
-  int fl, fr;
-  f.getTrackTorque(&fl, &fr);
-  EXPECT_LT(std::abs(fl), 20);
+  double free_torque = 0;
+  for (int i = 0; i < 100; ++i) {
+    free_world.step();
+    int fl, fr;
+    f.getTrackTorque(&fl, &fr);
+    free_torque += 0.5 * (fl + fr) / 100.0;
+  }
+  EXPECT_LT(std::abs(free_torque), 20) << "mean torque on free ground [units]";
 }
 
 TEST(Treels, ApiRangeIsClampedThenLimitedTo70) {
@@ -157,12 +162,14 @@ double breakawayForce() {
   Robot& r = w.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_0");
   r.setTracksPassive(true);
   runFor(w, 0.5);
+  const double x0 = r.basePose().position.x();
   const double ramp = 0.2;  // [N/s]
   for (double force = 0; force < 3.0; force += ramp * w.config().step) {
     const Vec3 p = r.basePose().position;
     dBodyAddForceAtPos(r.baseBody(), force, 0, 0, p.x(), p.y(), p.z());
     w.step();
-    if (r.linearVelocity().x() > 0.01) return force;
+    // Rocking onto a caster moves the base a few mm; rolling away moves it on and on.
+    if (r.basePose().position.x() - x0 > 0.01) return force;
   }
   return 3.0;
 }
