@@ -24,6 +24,7 @@ APT_PACKAGES=(
   libtf2-ros-dev libimage-transport-dev libcv-bridge-dev libvisualization-msgs-dev libnav-msgs-dev
   libsensor-msgs-dev libgeometry-msgs-dev libstd-srvs-dev ros-robot-state-publisher rviz
   python3-rosbag python3-rostest python3-roslaunch python3-rostopic python3-rosnode python3-rosservice
+  python3-nav-msgs python3-std-srvs python3-geometry-msgs python3-sensor-msgs python3-rospkg
   rosbash libode-dev liburdfdom-dev liburdfdom-tools libopencv-dev libeigen3-dev libyaml-cpp-dev
   libgtest-dev python3-yaml python3-numpy python3-matplotlib xvfb xauth
 )
@@ -43,10 +44,20 @@ deps() {
   fi
 }
 
+# What of the repository root belongs to the root package `swarmbot3d`. It is linked item by item:
+# a link to the root itself would contain build/ws/src/swarmbot3d again, and roslaunch/rosrun, which
+# walk a package's folder following links, would loop through it.
+ROOT_PACKAGE_ITEMS=(package.xml CMakeLists.txt src launch config test datasets docs)
+
 workspace() {
   mkdir -p "$WS/src"
-  ln -sfn "$ROOT" "$WS/src/swarmbot3d"
   for p in "${PACKAGES[@]}"; do ln -sfn "$ROOT/$p" "$WS/src/$p"; done
+  [[ -L "$WS/src/swarmbot3d" ]] && rm "$WS/src/swarmbot3d"
+  mkdir -p "$WS/src/swarmbot3d"
+  for item in "${ROOT_PACKAGE_ITEMS[@]}"; do
+    [[ -e "$ROOT/$item" ]] && ln -sfn "$ROOT/$item" "$WS/src/swarmbot3d/$item"
+  done
+  return 0
 }
 
 build() {
@@ -79,8 +90,11 @@ demo() {
   # Our own master on a free port: never assume one is running, never disturb one that is.
   local port=$((11400 + RANDOM % 500))
   export ROS_MASTER_URI="http://127.0.0.1:$port"
-  roslaunch -p "$port" swarmbot3d swarm.launch headless:=true record:=true duration:=30 \
-      bag:="$out/demo.bag" robots:=20 >"$out/roslaunch.log" 2>&1 || true
+  # Real-time factor 2 and 20 Hz state topics: as fast as possible, rosbag on a shared 2-core
+  # machine cannot keep up with 20 robots' topics and drops messages.
+  roslaunch -p "$port" "$ROOT/launch/swarm.launch" headless:=true record:=true duration:=30 \
+      real_time_factor:=2 publish_rate:=20 bag:="$out/demo.bag" robots:=20 >"$out/roslaunch.log" 2>&1 || true
+  grep -h "simulator: " "$out/roslaunch.log" | sed 's/^.*simulator: /simulator: /' || true
   [[ -f "$out/demo.bag" ]] || { tail -n 40 "$out/roslaunch.log"; log "demo failed: no bag written"; exit 1; }
   "$PY" "$ROOT/src/bag_summary.py" "$out/demo.bag"
 }

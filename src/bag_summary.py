@@ -23,7 +23,9 @@ def summarise(path):
     travelled = {r: 0.0 for r in robots}
     last = {}
     first_stamp = last_stamp = None
-    for topic, msg, _ in bag.read_messages(topics=['/%s/ground_truth' % r for r in robots]):
+    # read_messages() with no matching topic would return every message: ask only for present ones.
+    wanted = [t for t in ('/%s/ground_truth' % r for r in robots) if t in topics]
+    for topic, msg, _ in (bag.read_messages(topics=wanted) if wanted else []):
         robot = topic.split('/')[1]
         p = msg.pose.pose.position
         if robot in last:
@@ -58,7 +60,10 @@ def main():
         print('distance travelled per robot [m]: mean %.2f, min %.2f, max %.2f'
               % (sum(dist) / len(dist), min(dist), max(dist)))
         for r in robots[:5]:
-            print('  %-8s travelled %.2f m, final position (%.2f, %.2f)' % (r, travelled[r], final[r][0], final[r][1]))
+            if r in final:
+                print('  %-8s travelled %.2f m, final position (%.2f, %.2f)' % (r, travelled[r], final[r][0], final[r][1]))
+            else:
+                print('  %-8s no ground_truth recorded' % r)
         if len(robots) > 5:
             print('  ... (%d more)' % (len(robots) - 5))
     required = args.require_topic or (['/clock', '/tf'] + ['/%s/ground_truth' % r for r in robots])

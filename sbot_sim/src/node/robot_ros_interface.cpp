@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include <nav_msgs/Odometry.h>
 #include <sbot_msgs/ModelLevel.h>
@@ -16,6 +17,7 @@ namespace {
 /// The cmd_vel track separation comes from this joint's lateral offset (seed: centre wheels 8.2 cm).
 constexpr const char* kTrackJoint = "left_wheel_joint";
 constexpr double kFallbackTrackSeparation = 0.082;  // [m] seed Table 2.2, centre wheels separation
+constexpr std::uint32_t kStateQueue = 100;
 
 geometry_msgs::Point toPoint(const sbot::Vec3& v) {
   geometry_msgs::Point p;
@@ -57,10 +59,11 @@ bool WarnThrottle::ready() {
 RobotRosInterface::RobotRosInterface(ros::NodeHandle nh, sbot::Robot& robot, bool set_description_params)
     : nh_(nh, robot.name()), name_(robot.name()), set_description_params_(set_description_params) {
   base_frame_ = name_ + "/base_link";
-  ground_truth_pub_ = nh_.advertise<nav_msgs::Odometry>("ground_truth", 10);
-  joint_states_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", 10);
-  track_state_pub_ = nh_.advertise<sbot_msgs::TrackState>("track_state", 10);
-  turret_state_pub_ = nh_.advertise<sbot_msgs::TurretState>("turret/state", 10);
+  // Deep queues: as fast as possible, the simulator outpaces subscribers such as rosbag in bursts.
+  ground_truth_pub_ = nh_.advertise<nav_msgs::Odometry>("ground_truth", kStateQueue);
+  joint_states_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", kStateQueue);
+  track_state_pub_ = nh_.advertise<sbot_msgs::TrackState>("track_state", kStateQueue);
+  turret_state_pub_ = nh_.advertise<sbot_msgs::TurretState>("turret/state", kStateQueue);
   model_level_pub_ = nh_.advertise<sbot_msgs::ModelLevel>("model_level", 1, /*latch=*/true);
   bind(robot);
   // Subscribers and services last: callbacks only run from the simulator's loop, but keep the

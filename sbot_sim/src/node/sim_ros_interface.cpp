@@ -1,8 +1,8 @@
 #include "sim_ros_interface.h"
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
-#include <thread>
 
 #include <ros/callback_queue.h>
 #include <rosgraph_msgs/Clock.h>
@@ -25,6 +25,10 @@ double secondsSince(SteadyClock::time_point t) {
 constexpr double kMaxPacingLag = 0.25;
 
 }  // namespace
+
+volatile std::sig_atomic_t SimRosInterface::stop_requested_ = 0;
+
+void SimRosInterface::requestStop(int) { stop_requested_ = 1; }
 
 SimRosInterface::SimRosInterface() : pnh_("~") {}
 
@@ -89,9 +93,10 @@ bool SimRosInterface::init() {
   // Every node started after this one follows /clock (the launch files set it too).
   ros::param::set("/use_sim_time", true);
 
-  clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 1000);
   tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
-  for (sbot::Robot* r : world_->robots()) robots_.push_back(std::make_unique<RobotRosInterface>(nh_, *r, params_.set_description_params));
+  for (sbot::Robot* r : world_->robots())
+    robots_.push_back(std::make_unique<RobotRosInterface>(nh_, *r, params_.set_description_params));
 
   ros::NodeHandle sim(nh_, "sim");
   pause_srv_ = sim.advertiseService("pause", &SimRosInterface::onPause, this);
@@ -101,10 +106,11 @@ bool SimRosInterface::init() {
   set_pose_srv_ = sim.advertiseService("set_pose", &SimRosInterface::onSetPose, this);
 
   const double dt = world_->config().step;
+  char duration[64] = "unlimited";
+  if (end_time_ > 0) std::snprintf(duration, sizeof(duration), "%g s", end_time_);
   ROS_INFO("simulator: scenario %s: %zu robots (%s), step %g s, seed %llu, duration %s%s",
            scenario_.source.c_str(), world_->robotCount(), robotList().c_str(), dt,
-           static_cast<unsigned long long>(world_->config().seed),
-           end_time_ > 0 ? (std::to_string(end_time_) + " s").c_str() : "unlimited",
+           static_cast<unsigned long long>(world_->config().seed), duration,
            paused_ ? "; starting paused (call /sim/unpause or /sim/step)" : "");
   if (params_.publish_rate * dt > 1.0 + 1e-9)
     ROS_WARN("simulator: ~publish_rate %g Hz exceeds the step rate %g Hz: publishing every step",
@@ -176,6 +182,10 @@ int SimRosInterface::run() {
   resetPacing();
   std::string reason = "shutdown requested";
   while (ros::ok()) {
+    if (stop_requested_) {
+      reason = "interrupted";
+      break;
+    }
     if (!world_) {
       logSummary("no world after a failed reset");
       return 1;
@@ -186,7 +196,9 @@ int SimRosInterface::run() {
     }
     if (paused_) {
       // Services (unpause, step, reset, set_pose) and commands are served while paused.
+      const auto t = SteadyClock::now();
       queue->callAvailable(ros::WallDuration(0.05));
+      paused_wall_ += secondsSince(t);
       resetPacing();
       continue;
     }
@@ -213,10 +225,22 @@ int SimRosInterface::run() {
 
 void SimRosInterface::logSummary(const std::string& reason) const {
   const double wall = secondsSince(run_start_);
+  const double running = wall - paused_wall_;  // RTM over the time the simulation was running
   const double sim = (world_ ? simTime() : time_offset_) - run_start_sim_;
-  ROS_INFO("simulator: %s: sim time %.3f s, wall time %.3f s, RTM %.3f, robots %zu, steps %llu, resets %llu",
-           reason.c_str(), sim, wall, wall > 0 ? sim / wall : 0.0, robots_.size(),
-           static_cast<unsigned long long>(total_steps_), static_cast<unsigned long long>(reset_count_));
+  char line[320];
+  std::snprintf(line, sizeof(line),
+                "simulator: %s: sim time %.3f s, wall time %.3f s (%.3f s paused), RTM %.3f, robots %zu, "
+                "steps %llu, resets %llu", reason.c_str(), sim, wall, paused_wall_,
+                running > 1e-9 ? sim / running : 0.0, robots_.size(),
+                static_cast<unsigned long long>(total_steps_ - reset_count_),  // a reset counts one step
+                static_cast<unsigned long long>(reset_count_));
+  if (ros::ok()) {
+    ROS_INFO("%s", line);
+  } else {
+    // Shut down from outside (rosnode kill, master gone): rosconsole no longer prints.
+    std::printf("[ INFO] %s\n", line);
+    std::fflush(stdout);
+  }
 }
 
 std::string SimRosInterface::robotList() const {
@@ -238,7 +262,8 @@ std::string SimRosInterface::robotList() const {
 
 bool SimRosInterface::onPause(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
   res.success = true;
-  res.message = std::string(paused_ ? "already paused" : "paused") + " at t=" + std::to_string(simTime()) + " s";
+  res.message = std::string(paused_ ? "already paused" : "paused") + " at t=" + std::to_string(simTime()) +
+                " s";
   if (!paused_) ROS_INFO("simulator: paused at t=%.3f s", simTime());
   paused_ = true;
   return true;
@@ -246,7 +271,8 @@ bool SimRosInterface::onPause(std_srvs::Trigger::Request&, std_srvs::Trigger::Re
 
 bool SimRosInterface::onUnpause(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
   res.success = true;
-  res.message = std::string(paused_ ? "running" : "already running") + " from t=" + std::to_string(simTime()) + " s";
+  res.message = std::string(paused_ ? "running" : "already running") + " from t=" +
+                std::to_string(simTime()) + " s";
   if (paused_) ROS_INFO("simulator: running from t=%.3f s", simTime());
   paused_ = false;
   resetPacing();
@@ -308,7 +334,7 @@ bool SimRosInterface::onStep(sbot_msgs::Step::Request& req, sbot_msgs::Step::Res
   }
   try {
     std::uint32_t done = 0;
-    for (; done < req.steps && !durationReached() && ros::ok(); ++done) stepOnce();
+    for (; done < req.steps && !durationReached() && ros::ok() && !stop_requested_; ++done) stepOnce();
     res.success = true;
     if (done < req.steps)
       res.message = "stopped after " + std::to_string(done) + " of " + std::to_string(req.steps) +
@@ -332,7 +358,8 @@ bool SimRosInterface::onSetPose(sbot_msgs::SetPose::Request& req, sbot_msgs::Set
     res.message = "unknown robot '" + req.robot + "' (robots: " + robotList() + ")";
     return true;
   }
-  const std::pair<const char*, double> fields[] = {{"x", req.x}, {"y", req.y}, {"z", req.z}, {"yaw", req.yaw}};
+  const std::pair<const char*, double> fields[] = {
+      {"x", req.x}, {"y", req.y}, {"z", req.z}, {"yaw", req.yaw}};
   for (const auto& f : fields) {
     if (!std::isfinite(f.second)) {
       res.message = std::string("field ") + f.first + " is not finite (" + std::to_string(f.second) + ")";

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <chrono>
+#include <csignal>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -29,9 +30,10 @@ struct NodeParams {
   int robots = -1;               ///< ~robots: robot count, -1 = the scenario's
   double real_time_factor = 1.0; ///< ~real_time_factor: 0 = as fast as possible, 1 = real time
   double duration = 0;           ///< ~duration [s simulated]: 0 = the scenario's (0 there = unlimited)
-  double publish_rate = 50;      ///< ~publish_rate [Hz sim]: ground truth, joint states, track/turret state, tf
+  double publish_rate = 50;      ///< ~publish_rate [Hz sim]: ground truth, joint/track/turret state, tf
   bool paused = false;           ///< ~paused: start paused
-  bool set_description_params = false;  ///< ~set_description_params: set <robot>/robot_description, tf_prefix
+  /// ~set_description_params: also set <robot>/robot_description and <robot>/tf_prefix
+  bool set_description_params = false;
 };
 
 class SimRosInterface {
@@ -44,6 +46,8 @@ class SimRosInterface {
   bool init();
   /// The simulation loop. Returns the process exit code.
   int run();
+  /// Signal handler (SIGINT, SIGTERM): the loop stops after the current step.
+  static void requestStop(int signal);
 
  private:
   bool readParams();
@@ -66,6 +70,8 @@ class SimRosInterface {
   bool onStep(sbot_msgs::Step::Request& req, sbot_msgs::Step::Response& res);
   bool onSetPose(sbot_msgs::SetPose::Request& req, sbot_msgs::SetPose::Response& res);
 
+  static volatile std::sig_atomic_t stop_requested_;
+
   ros::NodeHandle nh_, pnh_;
   NodeParams params_;
   sbot::Scenario scenario_;
@@ -87,6 +93,7 @@ class SimRosInterface {
   double pace_sim_ = 0;
   std::chrono::steady_clock::time_point run_start_;
   double run_start_sim_ = 0;
+  double paused_wall_ = 0;  ///< [s wall] spent paused (stepping through /sim/step included)
 
   ros::Publisher clock_pub_;
   std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;

@@ -1,11 +1,17 @@
 // simulator_node: runs one scenario of the s-bot swarm simulator and exposes it to ROS.
 // Parameters, topics and services: see sim_ros_interface.h and the README.
+#include <csignal>
+
 #include <ros/ros.h>
 
 #include "sim_ros_interface.h"
 
 int main(int argc, char** argv) {
-  ros::init(argc, argv, "simulator");
+  // Our own SIGINT/SIGTERM handling: the loop finishes its step, logs the run summary, then shuts
+  // ROS down (roscpp's handler would shut down first and swallow the summary).
+  ros::init(argc, argv, "simulator", ros::init_options::NoSigintHandler);
+  std::signal(SIGINT, sbot_node::SimRosInterface::requestStop);
+  std::signal(SIGTERM, sbot_node::SimRosInterface::requestStop);
   int code = 1;
   {
     sbot_node::SimRosInterface sim;

@@ -30,7 +30,9 @@
 //     with these units happens above 118 mcd/cm^2 (e.g. a 1.18e6 mcd = 1180 cd lamp at 1 m, or a
 //     118 cd lamp at 31.6 cm).
 //   * cost: sources whose unshadowed contribution is below `cull_units` (0.01 reading units) are
-//     skipped before any ray is cast (an LED at full white is culled beyond 1.46 m).
+//     skipped before any ray is cast (an LED at full white is culled beyond 1.46 m); LEDs whose
+//     ring faces away from the sensor are hidden by their own turret without a ray (ledFaces);
+//     readAll() collects the lit LEDs once for the 8 sensors.
 // Noise: none by default (the seed specifies none for light); `noise` > 0 adds uniform relative
 // noise E (1 + U(-noise, noise)) from the robot's stream "light", after the effects.
 // Effects see channel "light", value = E [mcd/cm^2] (ambient included), surface empty.
@@ -38,8 +40,10 @@
 
 #include <array>
 #include <string>
+#include <vector>
 
 #include "sbot_sim/core/sensors/environment.h"
+#include "sbot_sim/core/sensors/sensor_common.h"
 #include "sbot_sim/core/types.h"
 
 namespace sbot {
@@ -84,6 +88,8 @@ class LightSensors {
 
  private:
   bool visible(const Vec3& from, const Vec3& to, double clearance) const;
+  double illuminance(int sensor, const std::vector<LedSource>& leds) const;
+  unsigned finish(int sensor, double illuminance);
   World& world_;
   Robot& robot_;
   const Environment& env_;

@@ -35,15 +35,16 @@
 //     ray-traced model above against a Simple s-bot, averaged over 16 headings of the target; see
 //     IrLookupTable. Against an s-bot the ray-traced readings beyond ~3 cm are lower than against a
 //     flat wall (-19 % at 5 cm): the two lower rays pass under the neighbour's turret. When several
-//     s-bots are in view the largest reading wins. The table's reading
-//     is converted back to an equivalent distance (response().distance) to serve as the raw value.
+//     s-bots are in view the largest reading wins. The table's reading is converted back to an
+//     equivalent distance (response().distance, may exceed 20 cm for weak readings) as raw value.
 //
 // Noise (Table 2.8, 2.2.6 "uniform noise of 10 % has been added to the distance measurements"):
 // d' = d (1 + U(-0.1, 0.1)) drawn from the robot's stream "ir", applied AFTER the world effects
 // (effects act on the noise-free physical distance; the noise belongs to the sensor electronics).
 // A 10 % distance error is about +-19 % in reading below 5 cm (slope -1.9). The reading is
-// round(response(d')), clamped to [0, 8191]. A sensor that detects nothing reads 0 and neither
-// calls the effects nor draws noise.
+// round(response.signal(d')), clamped to [0, 8191]; the 20 cm cut applies to detection only, not
+// after effects/noise (a wall at 19.5 cm with +10 % noise reads ~15, not 0). A sensor that detects
+// nothing reads 0 and neither calls the effects nor draws noise.
 // The SensorSample passed to the effects: channel "ir", index = sensor, value = distance [m],
 // surface and incidence of the nearest ray hit (ray-traced; "robot" and 0 for the table).
 #pragma once

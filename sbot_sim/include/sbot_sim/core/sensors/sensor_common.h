@@ -82,5 +82,24 @@ std::vector<Vec3> coneRays(int rays, double half_angle, double first_azimuth);
 /// Wrap an angle to (-pi, pi].
 double wrapPi(double a);
 
+struct LedGroup;
+class Environment;
+
+/// One lit LED group of a robot's light ring, as a light source for light sensors and cameras.
+struct LedSource {
+  Vec3 position = Vec3::Zero();  ///< [m] world, the robot's light_<group> frame origin
+  Vec3 normal = Vec3::UnitX();   ///< outward direction of the ring there (frame +x)
+  const LedGroup* led = nullptr; ///< colour
+  const Robot* robot = nullptr;
+  int group = 0;
+};
+/// Every LED group lit at the World's current time, of every robot except `exclude`.
+std::vector<LedSource> litLeds(World& world, const Environment& env, const Robot* exclude);
+/// Whether an LED on a convex ring can be seen from `viewer` at all: viewer in front of the ring's
+/// tangent plane at the LED (otherwise the LED's own turret hides it; no ray needed).
+inline bool ledFaces(const LedSource& led, const Vec3& viewer) {
+  return led.normal.dot(viewer - led.position) > 0;
+}
+
 }  // namespace sensors
 }  // namespace sbot

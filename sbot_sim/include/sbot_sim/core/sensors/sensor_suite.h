@@ -14,6 +14,11 @@
 //   Battery      Battery           all (must be updated every step: update(dt))
 //   Climate      ClimateSensors    all
 // A read on an unavailable channel returns zeros (and an empty blob list); check available().
+// Effects (effects.h): the IR, ground, light and sound modules pass their raw values through the
+// world's effects themselves; the suite does the same for the modules that have none: slope
+// (channel "slope", index 0 = pitch, 1 = roll, [deg]), battery ("battery", terminal voltage [V])
+// and climate ("temperature" [deg C] / "humidity" [%], index 0 = left, 1 = right), each before
+// rounding/clamping to the API range. The fake camera and the IMU accessors are not effected.
 // The light ring and speaker ACTUATORS (setLightColor, ...) are forwarded to the Environment so a
 // controller has the whole light/sound API in one place. Every module computes on read (no
 // per-step cost) except the battery. Units and models: see the module headers.
@@ -119,6 +124,7 @@ class SensorSuite {
   Robot& robot() { return robot_; }
 
  private:
+  void readClimate(ClimateSensor& sensor, int index, float* temperature, float* humidity);
   World& world_;
   Robot& robot_;
   Environment& env_;

@@ -66,7 +66,7 @@ class SoundSensors {
   double rawAmplitude(int mic) const;
   /// Noisy amplitude A_m (eq. 2.12 after effects and noise).
   double amplitude(int mic);
-  /// Noisy total perceived amplitude (eq. 2.13) at each microphone, in [0,1).
+  /// Noisy total perceived amplitude (eq. 2.13) at each microphone, in [0,1].
   std::array<double, kMicrophones> readAll();
   double read(int mic) { return totalPerceivedAmplitude(amplitude(mic)); }
 
