@@ -11,6 +11,7 @@
 //   ~speed       [units] cruise speed, 1 unit = 2.8 mm/s (default 50)
 //   ~seed        int     seed of this controller's random stream (default: hash of the namespace)
 //   ~rate        [Hz]    control rate in sim time (default 10)
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -75,8 +76,10 @@ class RandomWalk {
       bias_ = curvature(rng_);
       next_change_ = now + ros::Duration(hold(rng_));
     }
-    cmd.left = static_cast<int16_t>(std::lround(speed_ * (1 - bias_)));
-    cmd.right = static_cast<int16_t>(std::lround(speed_ * (1 + bias_)));
+    // Stay within the simulator's +-70 unit limit instead of relying on its clamping.
+    auto limited = [](double v) { return static_cast<int16_t>(std::lround(std::max(-70.0, std::min(70.0, v)))); };
+    cmd.left = limited(speed_ * (1 - bias_));
+    cmd.right = limited(speed_ * (1 + bias_));
     pub_.publish(cmd);
   }
 
