@@ -1,6 +1,10 @@
 // sbot_bench: how fast the headless core simulates swarms. Not a test: it prints figures.
 //
-//   sbot_bench [--level simple] [--robots 1,10,100] [--seconds 20] [--step 0.01]
+//   sbot_bench [--level simple] [--robots 1,10,100] [--seconds 20] [--step 0.01] [--chains K]
+//
+// --chains K: the robots form chains of K connected by static front-gripper links (robot i+1 grips
+// robot i; core/swarm/swarm_graph.h), each chain driving one random-walk command, and the swarm graph
+// (computeSwarmGraph, as /swarm/graph) is computed at 10 Hz; its cost is part of the timing.
 //
 // For every robot count it runs, in a fresh child process (so peak memory is that run's own), a
 // swarm doing a random walk on a flat arena, and prints the real-time multiplier RTM (simulated s
@@ -19,6 +23,7 @@
 #include <vector>
 
 #include "sbot_sim/core/robot_description.h"
+#include "sbot_sim/core/swarm/swarm_graph.h"
 #include "sbot_sim/core/world.h"
 
 namespace {
@@ -28,6 +33,7 @@ struct Options {
   std::vector<int> robots{1, 10, 100};
   double seconds = 20;
   double step = 0;  // 0: the level's recommended step
+  int chains = 0;   // robots per chain, 0 = unconnected
 };
 
 Options parse(int argc, char** argv) {
@@ -41,12 +47,13 @@ Options parse(int argc, char** argv) {
     if (a == "--level") o.level = next();
     else if (a == "--seconds") o.seconds = std::atof(next().c_str());
     else if (a == "--step") o.step = std::atof(next().c_str());
+    else if (a == "--chains") o.chains = std::atoi(next().c_str());
     else if (a == "--robots") {
       o.robots.clear();
       std::stringstream ss(next());
       for (std::string n; std::getline(ss, n, ',');) o.robots.push_back(std::atoi(n.c_str()));
     } else {
-      std::fprintf(stderr, "usage: sbot_bench [--level L] [--robots 1,10,100] [--seconds S] [--step DT]\n");
+      std::fprintf(stderr, "usage: sbot_bench [--level L] [--robots 1,10,100] [--seconds S] [--step DT] [--chains K]\n");
       std::exit(a == "--help" ? 0 : 2);
     }
   }
@@ -61,7 +68,11 @@ void runOne(const Options& o, int n) {
   c.seed = 1;
   const int side = static_cast<int>(std::ceil(std::sqrt(n)));
   const double spacing = 0.3;
-  const double arena = side * spacing + 1.0;
+  const int k = std::max(1, o.chains);
+  const int nchains = (n + k - 1) / k;
+  const int cside = static_cast<int>(std::ceil(std::sqrt(nchains)));
+  const double chain_dx = 0.147 * k + 0.3, chain_dy = 0.35;  // chain cells when --chains
+  const double arena = o.chains > 0 ? std::max(cside * chain_dx, cside * chain_dy) + 1.0 : side * spacing + 1.0;
   for (int k = 0; k < 4; ++k) {
     const double o2 = arena / 2;
     const bool ns = k < 2;
@@ -70,26 +81,50 @@ void runOne(const Options& o, int n) {
   }
   sbot::World w(c);
   for (int i = 0; i < n; ++i) {
+    if (o.chains > 0) {
+      const int c = i / k, j = i % k;  // chain c, member j (j = 0 leads)
+      const double cx = (c % cside - (cside - 1) / 2.0) * chain_dx + 0.147 * (k - 1) / 2.0;
+      const double cy = (c / cside - (cside - 1) / 2.0) * chain_dy;
+      w.addRobot(d, {cx - 0.147 * j, cy, 0}, "sbot_" + std::to_string(i));
+      if (j > 0)
+        sbot::swarm::createStaticLink(w, {"sbot_" + std::to_string(i), "sbot_" + std::to_string(i - 1),
+                                          sbot::swarm::kFrontGripper});
+      continue;
+    }
     w.addRobot(d, {(i % side - (side - 1) / 2.0) * spacing, (i / side - (side - 1) / 2.0) * spacing, 0.7 * i},
                "sbot_" + std::to_string(i));
   }
+  const int graph_every = std::max(1, static_cast<int>(std::lround(0.1 / c.step)));  // 10 Hz
+  std::size_t components = 0;
   const int steps = static_cast<int>(o.seconds / c.step);
   const int change_every = static_cast<int>(1.0 / c.step);  // new random command every simulated second
   const auto t0 = std::chrono::steady_clock::now();
   for (int s = 0; s < steps; ++s) {
     if (s % change_every == 0) {
-      for (sbot::Robot* r : w.robots()) {
-        r->setSpeed(static_cast<int>(r->random().uniform("walk", -70, 70)),
-                    static_cast<int>(r->random().uniform("walk", -70, 70)));
+      const std::vector<sbot::Robot*> robots = w.robots();
+      for (std::size_t i = 0; i < robots.size(); ++i) {
+        sbot::Robot* r = robots[i];
+        if (o.chains > 0 && i % k != 0) continue;  // a chain drives its leader's command
+        const int left = static_cast<int>(r->random().uniform("walk", -70, 70));
+        const int right = static_cast<int>(r->random().uniform("walk", -70, 70));
+        for (std::size_t m = i; m < robots.size() && (m == i || (o.chains > 0 && m % k != 0)); ++m)
+          robots[m]->setSpeed(left, right);
       }
     }
     w.step();
+    if (o.chains > 0 && s % graph_every == 0) components = sbot::swarm::computeSwarmGraph(w).components;
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
-  std::printf("%-8s %7d %10.1f %12.1f %14.3f %12.1f\n", o.level.c_str(), n, w.time(), w.time() / wall,
+  std::printf("%-8s %7d %10.1f %12.1f %14.3f %12.1f", o.level.c_str(), n, w.time(), w.time() / wall,
               1000.0 * wall / steps, ru.ru_maxrss / 1024.0);
+  if (o.chains > 0) {
+    // CPU-time RTM too: on a shared machine the wall clock includes waiting for a core.
+    const double cpu = ru.ru_utime.tv_sec + 1e-6 * ru.ru_utime.tv_usec + ru.ru_stime.tv_sec + 1e-6 * ru.ru_stime.tv_usec;
+    std::printf("   chains of %d, %zu components at the end, RTM by CPU time %.1f", k, components, w.time() / cpu);
+  }
+  std::printf("\n");
   std::fflush(stdout);
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/world.h"
@@ -44,6 +45,7 @@ Robot::Robot(World& world, const RobotDescription& description, const std::strin
 
 Robot::~Robot() {
   for (auto& h : hinges_) dJointDestroy(h.id);
+  for (dJointID j : loop_joints_) dJointDestroy(j);
   for (dGeomID g : geoms_) dGeomDestroy(g);
   if (space_) dSpaceDestroy(space_);
   for (dBodyID b : bodies_) dBodyDestroy(b);
@@ -74,6 +76,7 @@ void Robot::build(const Pose& base_pose) {
   }
 
   // 2. One ODE body per group, its frame at the group's centre of mass (ODE requires that).
+  const double inertia_floor = std::atof(d.extraOr("inertia_floor_kgm2", "0").c_str());
   space_ = dSimpleSpaceCreate(world_.space());
   std::vector<Pose> body_T_group(groups.size());
   for (std::size_t gi = 0; gi < groups.size(); ++gi) {
@@ -103,6 +106,13 @@ void Robot::build(const Pose& base_pose) {
     }
     const Vec3 com(total.c[0], total.c[1], total.c[2]);
     dMassTranslate(&total, -com.x(), -com.y(), -com.z());
+    // Inertia floor (sidecar extra inertia_floor_kgm2): the side arm's gram-sized links have
+    // moments near 1e-8 kg m^2, which ODE's iterative solver cannot hold together at a 10 ms step
+    // (the arm flails and explodes). Raising tiny principal moments to the floor keeps masses,
+    // centres of mass and statics exact and only slows such links' own rotational response.
+    if (inertia_floor > 0) {
+      for (int k = 0; k < 3; ++k) total.I[k * 4 + k] = std::max(total.I[k * 4 + k], inertia_floor);
+    }
     body_T_group[gi] = Pose(-com, Quat::Identity());
 
     dBodyID body = dBodyCreate(world_.odeWorld());
@@ -173,6 +183,67 @@ void Robot::build(const Pose& base_pose) {
   if (!d.turret.joint.empty()) turret_hinge_ = hinge_index_.at(d.turret.joint);
   addReflectedRotorInertia(left_hinges_);
   addReflectedRotorInertia(right_hinges_);
+  addLoopJoints(world_T_link, link_group);
+}
+
+void Robot::addLoopJoints(const std::map<std::string, Pose>& world_T_link,
+                          const std::map<std::string, std::pair<int, Pose>>& link_group) {
+  // URDF is a tree: the pins closing the side arm's scissor loops come from the sidecar
+  // (side_arm.loop_joints, see sbot_description/README.md). Each is a passive ODE hinge between
+  // the two named links' bodies at the parent's anchor, axis given in the parent frame. The robot's
+  // geoms never collide with each other, so no contact filtering is needed.
+  const YAML::Node arm = description_->sidecar["side_arm"];
+  if (!arm || !arm.IsMap() || !arm["loop_joints"]) return;
+  for (const auto& lj : arm["loop_joints"]) {
+    const std::string name = lj["name"].as<std::string>("loop_joint");
+    const std::string parent = lj["parent"].as<std::string>(""), child = lj["child"].as<std::string>("");
+    auto pg = link_group.find(parent), cg = link_group.find(child);
+    if (pg == link_group.end() || cg == link_group.end()) {
+      throw ConfigError(description_->sidecar_path, "side_arm.loop_joints." + name,
+                        "unknown link '" + (pg == link_group.end() ? parent : child) + "'");
+    }
+    if (pg->second.first == cg->second.first) continue;  // merged into one rigid body: nothing to close
+    auto vec3 = [](const YAML::Node& n, const Vec3& fallback) {
+      return n && n.IsSequence() && n.size() == 3 ? Vec3(n[0].as<double>(), n[1].as<double>(), n[2].as<double>())
+                                                   : fallback;
+    };
+    const Pose& w = world_T_link.at(parent);
+    const Vec3 anchor = w.transform(vec3(lj["anchor_in_parent"], Vec3::Zero()));
+    const Vec3 axis = w.orientation * vec3(lj["axis"], Vec3::UnitZ());
+    dJointID j = dJointCreateHinge(world_.odeWorld(), nullptr);
+    dJointAttach(j, bodies_[cg->second.first], bodies_[pg->second.first]);
+    dJointSetHingeAnchor(j, anchor.x(), anchor.y(), anchor.z());
+    dJointSetHingeAxis(j, axis.x(), axis.y(), axis.z());
+    loop_joints_.push_back(j);
+    loop_index_[name] = j;
+  }
+  // The scissor's own pins are passive; a small holding friction keeps the folded arm from
+  // flopping at rest (the servos, driven by the side-arm module, are far stronger: 0.04-0.07 N m).
+  constexpr double kHoldingTorque = 0.002;  // [N m]
+  if (arm["passive_joints"]) {
+    for (const auto& pj : arm["passive_joints"]) {
+      const Hinge* h = hinge(pj.as<std::string>());
+      if (!h) continue;
+      dJointSetHingeParam(h->id, dParamVel, 0);
+      dJointSetHingeParam(h->id, dParamFMax, kHoldingTorque);
+    }
+  }
+  // Until the side-arm module drives them, the powered servos hold their (rest) position with
+  // their own torque (URDF effort), as a real RC servo does: the arm stays folded.
+  if (arm["servos"] && arm["servos"].IsMap()) {
+    for (const auto& sv : arm["servos"]) {
+      const std::string jn = sv.second.as<std::string>("");
+      const Hinge* h = hinge(jn);
+      const JointDescription* jd = description_->findJoint(jn);
+      if (!h || !jd) continue;
+      dJointSetHingeParam(h->id, dParamVel, 0);
+      dJointSetHingeParam(h->id, dParamFMax, jd->effort > 0 ? jd->effort : kHoldingTorque);
+    }
+  }
+  for (dJointID j : loop_joints_) {
+    dJointSetHingeParam(j, dParamVel, 0);
+    dJointSetHingeParam(j, dParamFMax, kHoldingTorque);
+  }
 }
 
 void Robot::addReflectedRotorInertia(const std::vector<int>& track) {
@@ -203,6 +274,36 @@ const Robot::Hinge* Robot::hinge(const std::string& joint) const {
 
 double Robot::hingeRate(const Hinge& h) const { return dJointGetHingeAngleRate(h.id); }
 double Robot::hingeAngle(const Hinge& h) const { return h.angle; }
+
+// ---- joint access for actuator modules ----------------------------------------------------------
+
+dJointID Robot::hingeJoint(const std::string& joint) const {
+  const Hinge* h = hinge(joint);
+  if (h) return h->id;
+  auto it = loop_index_.find(joint);  // side-arm loop closures built by addLoopJoints()
+  return it == loop_index_.end() ? nullptr : it->second;
+}
+
+double Robot::jointAngle(const std::string& joint) const {
+  const Hinge* h = hinge(joint);
+  return h ? hingeAngle(*h) : 0.0;
+}
+
+double Robot::jointRate(const std::string& joint) const {
+  const Hinge* h = hinge(joint);
+  return h ? hingeRate(*h) : 0.0;
+}
+
+double Robot::jointEffort(const std::string& joint) const {
+  const Hinge* h = hinge(joint);
+  return h ? h->effort : 0.0;
+}
+
+dBodyID Robot::linkBody(const std::string& link) const {
+  auto it = link_index_.find(link);
+  if (it == link_index_.end() || it->second.body < 0) return nullptr;
+  return bodies_[it->second.body];
+}
 
 // ---- s-bot API ---------------------------------------------------------------------------------
 

@@ -162,7 +162,8 @@ void parseTerrain(const YAML::Node& n, TerrainConfig& t, const std::string& file
 
 void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
   Fields f(n, "world", file);
-  f.allowOnly({"step", "gravity", "solver_iterations", "solver_sor", "contact", "terrain"});
+  // lamps / ambient_light are read by the simulator node (sensed environment, not physics).
+  f.allowOnly({"step", "gravity", "solver_iterations", "solver_sor", "contact", "terrain", "lamps", "ambient_light"});
   w.step = f.positive("step", w.step);
   w.gravity = f.number("gravity", w.gravity);
   w.solver_iterations = static_cast<int>(f.positive("solver_iterations", w.solver_iterations));
@@ -196,7 +197,7 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
   }
   if (!root.IsMap()) throw ConfigError(file, "", "expected a mapping at the top level");
   Fields f(root, "", file);
-  f.allowOnly({"seed", "duration", "world", "robots", "swarm", "name", "description", "effects"});
+  f.allowOnly({"seed", "duration", "world", "robots", "swarm", "links", "name", "description", "effects"});
   Scenario s;
   s.source = file;
   const double seed = f.number("seed", 1);
@@ -268,6 +269,28 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
   std::set<std::string> names;
   for (const auto& r : s.robots) {
     if (!names.insert(r.name).second) throw ConfigError(file, "robots", "duplicate robot name '" + r.name + "'");
+  }
+  if (const YAML::Node links = f.node("links")) {
+    if (!links.IsSequence()) throw ConfigError(file, "links", "expected a list");
+    for (std::size_t i = 0; i < links.size(); ++i) {
+      const std::string path = "links[" + std::to_string(i) + "]";
+      Fields l(links[i], path, file);
+      l.allowOnly({"holder", "held", "kind"});
+      LinkSpawn link;
+      link.holder = l.text("holder", "");
+      link.held = l.text("held", "");
+      for (const auto* n : {&link.holder, &link.held}) {
+        const std::string field = l.path(n == &link.holder ? "holder" : "held");
+        if (n->empty()) throw ConfigError(file, field, "required");
+        if (!names.count(*n)) throw ConfigError(file, field, "unknown robot '" + *n + "'");
+      }
+      if (link.holder == link.held) throw ConfigError(file, path, "a robot cannot grip itself");
+      const std::string kind = l.text("kind", "front_gripper");
+      if (kind == "front_gripper") link.kind = 1;
+      else if (kind == "side_arm") link.kind = 2;
+      else throw ConfigError(file, l.path("kind"), "expected front_gripper or side_arm, found '" + kind + "'");
+      s.links.push_back(link);
+    }
   }
   return s;
 }

@@ -49,11 +49,15 @@ World::World(const WorldConfig& config) : config_(config) {
   dWorldSetContactSurfaceLayer(world_, 0.0005);
   dWorldSetContactMaxCorrectingVel(world_, 0.5);
   space_ = dHashSpaceCreate(nullptr);
+  static_space_ = dHashSpaceCreate(nullptr);
+  dSpaceSetSublevel(static_space_, 1);  // as the robots' spaces: dSpaceCollide2 iterates the static one
   contacts_ = dJointGroupCreate(0);
   buildTerrain();
+  connections_ = std::make_unique<ConnectionManager>(*this);
 }
 
 World::~World() {
+  connections_.reset();  // joints between robot bodies first
   robots_.clear();
   for (dGeomID g : static_geoms_) {
     delete static_cast<GeomInfo*>(dGeomGetData(g));
@@ -61,6 +65,7 @@ World::~World() {
   }
   if (heightfield_data_) dGeomHeightfieldDataDestroy(heightfield_data_);
   dJointGroupDestroy(contacts_);
+  dSpaceDestroy(static_space_);
   dSpaceDestroy(space_);
   dWorldDestroy(world_);
 }
@@ -72,10 +77,10 @@ void World::buildTerrain() {
     static_geoms_.push_back(g);
   };
   if (t.type != TerrainConfig::Type::Rough && t.ground_plane) {
-    addStatic(dCreatePlane(space_, 0, 0, 1, 0), kGround, "ground_plane");
+    addStatic(dCreatePlane(static_space_, 0, 0, 1, 0), kGround, "ground_plane");
   }
   for (const auto& box : t.boxes) {
-    dGeomID g = dCreateBox(space_, box.size.x(), box.size.y(), box.size.z());
+    dGeomID g = dCreateBox(static_space_, box.size.x(), box.size.y(), box.size.z());
     dGeomSetPosition(g, box.center.x(), box.center.y(), box.center.z());
     const Quat q = quatFromRPY(0, box.pitch, box.yaw);
     dQuaternion oq{q.w(), q.x(), q.y(), q.z()};
@@ -92,7 +97,7 @@ void World::buildTerrain() {
     const double lo = *std::min_element(heightfield_.begin(), heightfield_.end());
     const double hi = *std::max_element(heightfield_.begin(), heightfield_.end());
     dGeomHeightfieldDataSetBounds(heightfield_data_, lo - 0.01, hi + 0.01);
-    dGeomID g = dCreateHeightfield(space_, heightfield_data_, 1);
+    dGeomID g = dCreateHeightfield(static_space_, heightfield_data_, 1);
     dMatrix3 R;
     dRFromAxisAndAngle(R, 1, 0, 0, M_PI / 2);
     dGeomSetRotation(g, R);
@@ -128,6 +133,7 @@ Robot& World::addRobotAt(const RobotDescription& description, const Pose& pose, 
 void World::removeRobot(const std::string& name) {
   auto it = std::find_if(robots_.begin(), robots_.end(), [&](const auto& r) { return r->name() == name; });
   if (it == robots_.end()) throw UnknownName("unknown robot '" + name + "'");
+  connections_->removeRobot(name);
   robots_.erase(it);
 }
 
@@ -152,7 +158,11 @@ std::vector<Robot*> World::robots() {
 void World::step() {
   const double dt = config_.step;
   for (auto& r : robots_) r->applyCommands(dt, effects_);
-  dSpaceCollide(space_, this, &nearCallback);
+  dSpaceCollide(space_, this, &nearCallback);  // robot against robot
+  // Robot against terrain: each static geom's AABB against the robot's space, then the robot's
+  // geoms against the few static geoms that overlap it.
+  for (auto& r : robots_)
+    dSpaceCollide2(reinterpret_cast<dGeomID>(static_space_), reinterpret_cast<dGeomID>(r->space()), this, &nearCallback);
   // QuickStep shuffles constraints with ODE's one global generator; reseeding it from the step
   // count makes every run of a scenario bit-identical whatever other worlds did in this process.
   // (Worlds in parallel threads would share that generator: run parallel simulations as processes.)
@@ -254,6 +264,7 @@ RayHit World::castRay(const Vec3& origin, const Vec3& direction, double length, 
   dGeomRaySetClosestHit(ray, 1);
   RayQuery query{ignore, &best};
   dSpaceCollide2(ray, reinterpret_cast<dGeomID>(space_), &query, &rayCallback);
+  dSpaceCollide2(ray, reinterpret_cast<dGeomID>(static_space_), &query, &rayCallback);
   dGeomDestroy(ray);
   return best;
 }

@@ -9,6 +9,7 @@
 
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/robot_description.h"
+#include "sbot_sim/core/swarm/swarm_graph.h"
 
 namespace sbot_node {
 
@@ -34,6 +35,7 @@ SimRosInterface::SimRosInterface() : pnh_("~") {}
 
 SimRosInterface::~SimRosInterface() {
   // Interfaces hold pointers into the world: drop them first.
+  modules_.reset();  // modules hold references into the world
   robots_.clear();
   world_.reset();
 }
@@ -95,8 +97,21 @@ bool SimRosInterface::init() {
 
   clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 1000);
   tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
+  markers_ = std::make_unique<MarkerPublisher>(nh_, pnh_);
+  swarm_ = std::make_unique<SwarmRosInterface>(nh_, pnh_, world_, robots_, params_.set_description_params);
   for (sbot::Robot* r : world_->robots())
     robots_.push_back(std::make_unique<RobotRosInterface>(nh_, *r, params_.set_description_params));
+  bool modules = true;  // ~modules: false = no sensor/actuator modules (benchmarking the bare node)
+  pnh_.param("modules", modules, true);
+  if (modules) {
+    modules_ = std::make_unique<ModulesRosInterface>(nh_, pnh_, world_, params_.scenario);
+    modules_->attach();
+  }
+  if (swarm_ && modules_) {  // spawn / delete / model switch keep the modules bound
+    swarm_->before_delete.push_back([this](sbot::Robot& r) { modules_->robotRemoving(r); });
+    swarm_->after_spawn.push_back([this](sbot::Robot& r) { modules_->robotAdded(r); });
+    swarm_->after_switch.push_back([this](sbot::Robot& r) { modules_->robotRebuilt(r); });
+  }
 
   ros::NodeHandle sim(nh_, "sim");
   pause_srv_ = sim.advertiseService("pause", &SimRosInterface::onPause, this);
@@ -122,6 +137,7 @@ std::unique_ptr<sbot::World> SimRosInterface::buildWorld() const {
   auto world = std::make_unique<sbot::World>(scenario_.world);
   for (const sbot::RobotSpawn& s : scenario_.robots)
     world->addRobot(sbot::loadLevel(s.level), s.pose, s.name);
+  sbot::swarm::addScenarioLinks(*world, scenario_.links);  // static links (seed 2.2.3)
   return world;
 }
 
@@ -148,9 +164,12 @@ void SimRosInterface::publishStates() {
 
 void SimRosInterface::stepOnce() {
   world_->step();
+  if (modules_) modules_->afterStep(simTime());  // battery, gripper, side arm; sensor topics
   ++total_steps_;
   publishClock();
   publishStates();
+  if (markers_) markers_->update(*world_, simTime());
+  if (swarm_) swarm_->update(simTime());
 }
 
 bool SimRosInterface::durationReached() const {
@@ -291,6 +310,7 @@ bool SimRosInterface::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Re
     for (const sbot::RobotSpawn& s : scenario_.robots) sbot::loadLevel(s.level);
     // Tear the old world down before building the new one (one ODE world at a time).
     for (auto& iface : robots_) iface->unbind();
+    if (modules_) modules_->detach();
     world_.reset();
     // The rebuilt world starts at 0; ROS time continues one step later so stamps stay increasing.
     time_offset_ = before + scenario_.world.step;
@@ -307,7 +327,10 @@ bool SimRosInterface::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Re
     sbot::Robot* r = world_->findRobot(iface->name());
     if (r) iface->bind(*r);
   }
+  if (modules_) modules_->attach();
   ++reset_count_;
+  if (markers_) markers_->clearTrails();
+  if (swarm_) swarm_->republish();
   last_publish_tick_ = -1;  // publish the initial state now
   publishClock();
   publishStates();

@@ -19,7 +19,10 @@
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/transform_broadcaster.h>
 
+#include "marker_publisher.h"
 #include "robot_ros_interface.h"
+#include "swarm_ros_interface.h"
+#include "modules_ros_interface.h"
 #include "sbot_sim/core/scenario.h"
 #include "sbot_sim/core/world.h"
 
@@ -97,6 +100,11 @@ class SimRosInterface {
 
   ros::Publisher clock_pub_;
   std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;
+  std::unique_ptr<MarkerPublisher> markers_;  ///< /sim/markers (~marker_rate, ~trail_length)
+  /// /swarm/graph(_markers) (~graph_rate), /sim/set_model_level, /sim/spawn, /sim/delete
+  std::unique_ptr<SwarmRosInterface> swarm_;
+  /// Sensors and actuator modules of every robot (+ /sim/set_lamp, /sim/set_ambient_light)
+  std::unique_ptr<ModulesRosInterface> modules_;
   ros::ServiceServer pause_srv_, unpause_srv_, reset_srv_, step_srv_, set_pose_srv_;
 };
 

@@ -81,6 +81,31 @@ class Robot {
   /// Move the robot so base_link sits at `pose` with zero velocity (teleport).
   void setBasePose(const Pose& pose);
 
+  // ---- joint access for actuator modules (core/actuators: gripper, side arm) --------------------
+  /// ODE hinge of a moving URDF joint, nullptr if the level has no such joint. Hinges other than the
+  /// treels and the turret are passive (FMax 0) until a module drives them through this handle.
+  dJointID hingeJoint(const std::string& joint) const;
+  /// Unwrapped angle [rad], rate [rad/s] and last-step torque about the axis [N m] of a hinge; 0 if
+  /// the level has no such joint.
+  double jointAngle(const std::string& joint) const;
+  double jointRate(const std::string& joint) const;
+  double jointEffort(const std::string& joint) const;
+  /// ODE body carrying a URDF link (massless links are merged into a body); nullptr if absent.
+  dBodyID linkBody(const std::string& link) const;
+
+  // ---- dynamic model switching (seed 2.1.3; implemented in core/swarm/model_switch.cpp) ---------
+  /// Rebuild this robot's bodies, geoms and joints from `description` within the same step, in
+  /// place: this Robot object (name, index, random streams, every pointer to it) stays valid. Kept:
+  /// base pose, base linear and angular velocity, the angle and rate of every joint both levels
+  /// have (turret, gripper elevation, ...), the track speeds (wheel spin), the requested track
+  /// speeds, passive mode and the turret target. Joints other robots or modules attached to this
+  /// robot (World::connections(): gripper / side-arm connections) are re-attached, with the same
+  /// dJointID, to the new body carrying the same link (holder: gripper_tip / side-arm tip; held:
+  /// turret). Throws ConfigError if the levels differ in scale (Fast vs full size).
+  void switchDescription(const RobotDescription& description);
+  /// Turret position target [rad].
+  double turretTarget() const { return turret_target_; }
+
   RandomStreams& random() { return random_; }
 
   // ---- used by World -----------------------------------------------------------------------------
@@ -109,6 +134,8 @@ class Robot {
 
   void build(const Pose& base_pose);
   void addReflectedRotorInertia(const std::vector<int>& track);
+  void addLoopJoints(const std::map<std::string, Pose>& world_T_link,
+                     const std::map<std::string, std::pair<int, Pose>>& link_group);
   const Hinge* hinge(const std::string& joint) const;
   double hingeRate(const Hinge& h) const;
   double hingeAngle(const Hinge& h) const;
@@ -124,6 +151,8 @@ class Robot {
   std::vector<std::unique_ptr<GeomInfo>> geom_infos_;
   dSpaceID space_ = nullptr;             ///< this robot's geoms; never collided with itself
   std::vector<Hinge> hinges_;
+  std::vector<dJointID> loop_joints_;    ///< side-arm loop closures (sidecar side_arm.loop_joints)
+  std::map<std::string, dJointID> loop_index_;  ///< loop joint name -> joint (hingeJoint() finds them)
   std::map<std::string, int> hinge_index_;
   std::map<std::string, LinkFrame> link_index_;
   std::vector<int> left_hinges_, right_hinges_;

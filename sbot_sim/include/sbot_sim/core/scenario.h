@@ -15,6 +15,11 @@
 //     - {name: sbot_0, level: simple, pose: {x: 0, y: 0, yaw: 0}}
 //   swarm:                        # ... and/or generated ones, named sbot_<i> after the explicit ones
 //     {count: 20, level: simple, layout: grid, spacing: 0.3, center: [0, 0]}   # layout grid|random
+//   world.lamps: [{position: [x, y, z], intensity: mcd, colour: [r, g, b]}]   # read by the node
+//   world.ambient_light: 0.0      # [mcd/cm^2], read by the node (sensors/environment.h)
+//   links:                        # static connections (seed 2.2.3), made at start (and at reset):
+//     - {holder: sbot_1, held: sbot_0, kind: front_gripper}   # kind front_gripper | side_arm;
+//                                 # held is moved to holder's gripper_tip (see core/swarm/swarm_graph.h)
 #pragma once
 
 #include <string>
@@ -31,10 +36,17 @@ struct RobotSpawn {
   Pose2D pose;
 };
 
+/// A static link of the scenario's `links` list (core/swarm/swarm_graph.h createStaticLink).
+struct LinkSpawn {
+  std::string holder, held;
+  int kind = 1;                  ///< 1 front gripper, 2 side arm (sbot_msgs/SwarmGraph)
+};
+
 struct Scenario {
   std::string source;            ///< file it was read from
   WorldConfig world;
   std::vector<RobotSpawn> robots;
+  std::vector<LinkSpawn> links;  ///< after the robots; every name is one of `robots`
   double duration = 0;           ///< [s], 0 = unlimited
 };
 

@@ -8,6 +8,7 @@
 
 #include <ode/ode.h>
 
+#include "sbot_sim/core/actuators/connections.h"
 #include "sbot_sim/core/effects.h"
 #include "sbot_sim/core/robot.h"
 #include "sbot_sim/core/world_config.h"
@@ -35,6 +36,13 @@ class World {
   /// Spawn at an explicit 3D pose of base_link.
   Robot& addRobotAt(const RobotDescription& description, const Pose& pose, const std::string& name);
   void removeRobot(const std::string& name);
+  /// Dynamic model switching (seed 2.1.3): rebuild robot `name` from `description` in place, keeping
+  /// its state and connections (Robot::switchDescription). Throws UnknownName / ConfigError.
+  Robot& switchLevel(const std::string& name, const RobotDescription& description) {
+    Robot& r = robot(name);
+    r.switchDescription(description);
+    return r;
+  }
   Robot& robot(const std::string& name);            ///< throws UnknownName
   Robot* findRobot(const std::string& name);        ///< nullptr if absent
   std::vector<Robot*> robots();
@@ -56,8 +64,16 @@ class World {
   const std::vector<EffectPtr>& effects() const { return effects_; }
   void clearEffects() { effects_.clear(); }
 
+  /// Gripper / side-arm connections between robots (actuators/connections.h).
+  ConnectionManager& connections() { return *connections_; }
+  const ConnectionManager& connections() const { return *connections_; }
+
   dWorldID odeWorld() const { return world_; }
   dSpaceID space() const { return space_; }
+  /// The terrain's static geoms. Not inside space(): each step collides every robot's space with it
+  /// (dSpaceCollide2), so static geoms are never tested against each other (a course of hundreds
+  /// of boxes costs the broadphase almost nothing).
+  dSpaceID staticSpace() const { return static_space_; }
   dJointGroupID contactGroup() const { return contacts_; }
 
   // internal: collision callback trampoline
@@ -71,10 +87,12 @@ class World {
   WorldConfig config_;
   dWorldID world_ = nullptr;
   dSpaceID space_ = nullptr;
+  dSpaceID static_space_ = nullptr;
   dJointGroupID contacts_ = nullptr;
   std::vector<dGeomID> static_geoms_;
   std::map<dGeomID, std::string> static_material_;
   std::vector<std::unique_ptr<Robot>> robots_;
+  std::unique_ptr<ConnectionManager> connections_;  ///< destroyed before the robots
   std::vector<EffectPtr> effects_;
   double time_ = 0;
   std::uint64_t steps_ = 0;

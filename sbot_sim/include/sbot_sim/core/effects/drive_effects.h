@@ -119,13 +119,16 @@ class TorqueSaturationEffect : public ParametricEffect {
   void onCommand(const Robot& robot, TrackCommand& cmd, double dt) override;
 };
 
-/// Battery sag: speed and torque fall linearly with the time since the start of the run.
+/// Battery sag: speed and torque fall linearly with the time since the battery was charged: the
+/// robot's simulated time, plus an offset for runs recorded later in a session (setElapsed).
 class BatterySagEffect : public ParametricEffect {
  public:
   explicit BatterySagEffect(const std::map<std::string, double>& p);
   static EffectInfo describe();
   void onCommand(const Robot& robot, TrackCommand& cmd, double dt) override;
   void reset() override { elapsed_.clear(); }
+  /// Battery time of `robot` now [s] (e.g. a dataset run's start_time in its session).
+  void setElapsed(const std::string& robot, double seconds) { elapsed_(robot) = seconds; }
 
  private:
   PerRobot<double> elapsed_;

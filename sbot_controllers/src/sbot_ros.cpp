@@ -1,0 +1,549 @@
+// libsbot_ros: the standard s-bot API (include/sbot.h, seed Appendix A) over the swarmbot3d
+// simulator's ROS interface, for one robot chosen by namespace. See ../README.md for the mapping.
+//
+// * initSwarmBot starts a roscpp node "sbot_api" (anonymous) in the namespace $SBOT_NAMESPACE, else
+//   the one ROS gives the process (__ns:= on the command line, which we read from /proc/self/cmdline
+//   because sbot.h does not pass argc/argv, or $ROS_NAMESPACE as roslaunch sets it), with a private
+//   spinner thread. It waits (up to 30 s wall) for the robot's services.
+// * Getters return the latest received value. Topics are subscribed on first use (a sensor nobody
+//   reads costs the simulator nothing); the first call waits up to 2 s wall for a first message.
+// * Sampled sensors (proximity, ground, light, slope) behave like the hardware's sampling: a reading
+//   of one sensor is refreshed once per sampling period. A getter asked again for a sensor whose
+//   current sample it already returned waits (up to 1 s wall) for the next sample. A controller's
+//   read-act loop therefore runs once per sample in SIMULATED time, whatever the simulator's
+//   real-time factor. Set SBOT_NO_SAMPLE_WAIT=1 to always return the latest value at once.
+// * Setters publish (setSpeed -> cmd_speed, LEDs -> leds via set_leds) or call services (turret,
+//   gripper, side arm, sampling rates). Clamped values are reported through the warning handler,
+//   failures through the error handler (if given; else stderr).
+// * playMusic(filename): plays one tone on the simulated speaker (seed 2.2.10: one frequency at a
+//   time), at 200 + (FNV-1a hash of the filename mod 1800) Hz, so different files are
+//   distinguishable by the sound sensors; stopMusic() silences it.
+#include "sbot.h"
+
+#include <unistd.h>
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdarg>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <ros/ros.h>
+#include <sbot_msgs/Battery.h>
+#include <sbot_msgs/Climate.h>
+#include <sbot_msgs/GripperState.h>
+#include <sbot_msgs/GroundArray.h>
+#include <sbot_msgs/LedState.h>
+#include <sbot_msgs/LightArray.h>
+#include <sbot_msgs/ProximityArray.h>
+#include <sbot_msgs/SetGripper.h>
+#include <sbot_msgs/SetLeds.h>
+#include <sbot_msgs/SetSamplingRate.h>
+#include <sbot_msgs/SetSideArm.h>
+#include <sbot_msgs/SetTurret.h>
+#include <sbot_msgs/SideArmState.h>
+#include <sbot_msgs/Slope.h>
+#include <sbot_msgs/TrackSpeed.h>
+#include <sbot_msgs/TrackState.h>
+#include <sbot_msgs/TurretState.h>
+#include <std_msgs/Float64.h>
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+void (*g_error)(const char*) = nullptr;
+void (*g_warning)(const char*) = nullptr;
+
+void report(bool error, const char* fmt, ...) {
+  char buf[512];
+  va_list ap;
+  va_start(ap, fmt);
+  std::vsnprintf(buf, sizeof(buf), fmt, ap);
+  va_end(ap);
+  auto handler = error ? g_error : g_warning;
+  if (handler) {
+    handler(buf);
+  } else {
+    std::fprintf(stderr, "sbot %s: %s\n", error ? "error" : "warning", buf);
+  }
+}
+
+/// Latest message of one topic, subscribed on first use, with per-index "already returned" stamps.
+template <class Msg>
+class Latest {
+ public:
+  Latest(const char* topic, std::size_t indices) : topic_(topic), returned_(indices, ros::Time(0)) {}
+
+  /// Copy of the latest message; waits for a first one, and (with `fresh`) for one newer than the
+  /// sample index `index` last returned (index = npos: all indices).
+  bool get(ros::NodeHandle& nh, Msg* out, bool fresh = false, std::size_t index = npos) {
+    std::unique_lock<std::mutex> lock(m_);
+    if (!sub_) {
+      sub_ = nh.subscribe<Msg>(topic_, 5, [this](const typename Msg::ConstPtr& msg) {
+        std::lock_guard<std::mutex> l(m_);
+        msg_ = *msg;
+        has_ = true;
+        ++seq_;
+        cv_.notify_all();
+      }, ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+    }
+    if (!has_) cv_.wait_for(lock, std::chrono::seconds(2), [this] { return has_; });
+    if (!has_) return false;
+    if (fresh && sampleWait()) {
+      auto stale = [&] {
+        const ros::Time s = stamp(msg_);
+        if (index == npos) {
+          for (const auto& r : returned_)
+            if (r >= s) return true;
+          return false;
+        }
+        return returned_[index] >= s;
+      };
+      if (stale()) cv_.wait_for(lock, std::chrono::seconds(1), [&] { return !stale() || !ros::ok(); });
+    }
+    const ros::Time s = stamp(msg_);
+    if (index == npos) {
+      for (auto& r : returned_) r = s;
+    } else if (index < returned_.size()) {
+      returned_[index] = s;
+    }
+    *out = msg_;
+    return true;
+  }
+  static constexpr std::size_t npos = static_cast<std::size_t>(-1);
+
+ private:
+  static bool sampleWait() {
+    static const bool wait = !(std::getenv("SBOT_NO_SAMPLE_WAIT") && std::string(std::getenv("SBOT_NO_SAMPLE_WAIT")) == "1");
+    return wait;
+  }
+  template <class M>
+  static auto stamp(const M& m) -> decltype(m.header.stamp) { return m.header.stamp; }
+  std::string topic_;
+  std::mutex m_;
+  std::condition_variable cv_;
+  ros::Subscriber sub_;
+  Msg msg_;
+  bool has_ = false;
+  std::uint64_t seq_ = 0;
+  std::vector<ros::Time> returned_;
+};
+
+struct Api {
+  std::unique_ptr<ros::NodeHandle> nh;
+  std::unique_ptr<ros::AsyncSpinner> spinner;
+  ros::Publisher speed_pub, speaker_pub;
+  Latest<sbot_msgs::ProximityArray> proximity{"proximity", 15};
+  Latest<sbot_msgs::GroundArray> ground{"ground", 4};
+  Latest<sbot_msgs::LightArray> light{"light", 8};
+  Latest<sbot_msgs::Slope> slope{"slope", 1};
+  Latest<sbot_msgs::Battery> battery{"battery", 1};
+  Latest<sbot_msgs::Climate> climate{"climate", 1};
+  Latest<sbot_msgs::TrackState> tracks{"track_state", 1};
+  Latest<sbot_msgs::TurretState> turret{"turret/state", 1};
+  Latest<sbot_msgs::GripperState> gripper{"gripper/state", 1};
+  Latest<sbot_msgs::SideArmState> side_arm{"side_arm/state", 1};
+  std::mutex cmd_m;
+  bool gripper_known = false;
+  int gripper_elevation = 0, gripper_aperture = 0;  ///< last commanded
+  bool arm_known = false;
+  int arm_e = 0, arm_r = 0, arm_d = 60;
+};
+
+std::unique_ptr<Api> g;
+
+bool ready(const char* fn) {
+  if (g && g->nh && ros::ok()) return true;
+  report(true, "%s: initSwarmBot() has not been called (or ROS shut down)", fn);
+  return false;
+}
+
+std::vector<std::string> processArgs() {
+  std::vector<std::string> args;
+  std::ifstream f("/proc/self/cmdline", std::ios::binary);
+  std::string a;
+  while (std::getline(f, a, '\0')) args.push_back(a);
+  if (args.empty()) args.push_back("sbot_controller");
+  return args;
+}
+
+template <class Srv>
+bool call(const char* service, Srv& srv, const char* fn) {
+  if (!ready(fn)) return false;
+  ros::ServiceClient c = g->nh->serviceClient<Srv>(service);
+  if (!c.call(srv)) {
+    report(true, "%s: service %s/%s failed (is the simulator running?)", fn, g->nh->getNamespace().c_str(), service);
+    return false;
+  }
+  if (!srv.response.success) {
+    report(true, "%s: %s", fn, srv.response.message.c_str());
+    return false;
+  }
+  if (!srv.response.message.empty()) report(false, "%s: %s", fn, srv.response.message.c_str());
+  return true;
+}
+
+void setRate(const char* channel, SamplingRate rate, const char* fn) {
+  sbot_msgs::SetSamplingRate srv;
+  srv.request.channel = channel;
+  srv.request.rate = static_cast<uint8_t>(rate > 255 ? 255 : rate);
+  call("set_sampling_rate", srv, fn);
+}
+
+void gripperCommand(const char* fn) {
+  sbot_msgs::SetGripper srv;
+  srv.request.elevation = static_cast<int16_t>(g->gripper_elevation);
+  srv.request.aperture = static_cast<int16_t>(g->gripper_aperture);
+  if (call("set_gripper", srv, fn) && srv.response.clamped) {
+    g->gripper_elevation = srv.response.applied_elevation;
+    g->gripper_aperture = srv.response.applied_aperture;
+  }
+}
+
+void knowGripper() {
+  if (g->gripper_known) return;
+  sbot_msgs::GripperState s;
+  if (g->gripper.get(*g->nh, &s)) {
+    g->gripper_elevation = s.elevation;
+    g->gripper_aperture = s.aperture;
+  }
+  g->gripper_known = true;
+}
+
+void knowArm() {
+  if (g->arm_known) return;
+  sbot_msgs::SideArmState s;
+  if (g->side_arm.get(*g->nh, &s)) {
+    g->arm_e = s.elevation;
+    g->arm_r = s.rotation;
+    g->arm_d = s.depth;
+  }
+  g->arm_known = true;
+}
+
+void armCommand(uint8_t jaws, const char* fn) {
+  sbot_msgs::SetSideArm srv;
+  srv.request.elevation = static_cast<int16_t>(g->arm_e);
+  srv.request.rotation = static_cast<int16_t>(g->arm_r);
+  srv.request.depth = static_cast<int16_t>(g->arm_d);
+  srv.request.jaws = jaws;
+  call("set_side_arm", srv, fn);
+}
+
+void leds(const std::vector<unsigned>& groups, const unsigned* r, const unsigned* gr, const unsigned* b,
+          const BlinkingRate* blink, bool same, const char* fn) {
+  sbot_msgs::SetLeds srv;
+  for (std::size_t i = 0; i < groups.size(); ++i) {
+    const std::size_t k = same ? 0 : i;
+    srv.request.group.push_back(static_cast<uint8_t>(groups[i] > 255 ? 255 : groups[i]));
+    srv.request.r.push_back(static_cast<uint8_t>(r[k] > 255 ? 255 : r[k]));
+    srv.request.g.push_back(static_cast<uint8_t>(gr[k] > 255 ? 255 : gr[k]));
+    srv.request.b.push_back(static_cast<uint8_t>(b[k] > 255 ? 255 : b[k]));
+    srv.request.blink.push_back(static_cast<uint8_t>(blink[k] > 255 ? 255 : blink[k]));
+  }
+  call("set_leds", srv, fn);
+}
+
+}  // namespace
+
+extern "C" {
+
+void initSwarmBot(void (*errorHandler)(const char*), void (*warningHandler)(const char*)) {
+  g_error = errorHandler;
+  g_warning = warningHandler;
+  if (g) return;
+  std::vector<std::string> args = processArgs();
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(&a[0]);
+  int argc = static_cast<int>(argv.size());
+  if (!ros::isInitialized())
+    ros::init(argc, argv.data(), "sbot_api", ros::init_options::AnonymousName | ros::init_options::NoSigintHandler);
+  g = std::make_unique<Api>();
+  const char* ns = std::getenv("SBOT_NAMESPACE");
+  g->nh = std::make_unique<ros::NodeHandle>(ns && *ns ? std::string(ns) : std::string());
+  g->spinner = std::make_unique<ros::AsyncSpinner>(1);
+  g->spinner->start();
+  g->speed_pub = g->nh->advertise<sbot_msgs::TrackSpeed>("cmd_speed", 10);
+  g->speaker_pub = g->nh->advertise<std_msgs::Float64>("speaker", 10, true);
+  const std::string probe = g->nh->resolveName("set_gripper");
+  if (!ros::service::waitForService(probe, ros::Duration(30.0))) {
+    report(true, "initSwarmBot: %s not available after 30 s: is the simulator running and the namespace "
+                 "right (SBOT_NAMESPACE, __ns:=, ROS_NAMESPACE)?", probe.c_str());
+    return;
+  }
+  const auto until = Clock::now() + std::chrono::seconds(5);
+  while (g->speed_pub.getNumSubscribers() == 0 && Clock::now() < until) usleep(10000);
+}
+
+void shutdownSwarmBot(void) {
+  if (!g) return;
+  if (ros::ok()) {
+    setSpeed(0, 0);
+    usleep(100000);
+  }
+  g->spinner->stop();
+  g.reset();
+  ros::shutdown();
+}
+
+void setSpeed(int left, int right) {
+  if (!ready("setSpeed")) return;
+  if (left < -127 || left > 127 || right < -127 || right > 127)
+    report(false, "setSpeed(%d, %d): outside [-127, 127], clamped", left, right);
+  sbot_msgs::TrackSpeed m;
+  m.left = static_cast<int16_t>(left < -127 ? -127 : left > 127 ? 127 : left);
+  m.right = static_cast<int16_t>(right < -127 ? -127 : right > 127 ? 127 : right);
+  g->speed_pub.publish(m);
+}
+
+void getSpeed(int* left, int* right) {
+  sbot_msgs::TrackState s;
+  if (!ready("getSpeed") || !g->tracks.get(*g->nh, &s)) return;
+  if (left) *left = s.measured_left;
+  if (right) *right = s.measured_right;
+}
+
+void getTrackTorque(int* left, int* right) {
+  sbot_msgs::TrackState s;
+  if (!ready("getTrackTorque") || !g->tracks.get(*g->nh, &s)) return;
+  if (left) *left = s.torque_left;
+  if (right) *right = s.torque_right;
+}
+
+void setTurretRotation(int pos) {
+  sbot_msgs::SetTurret srv;
+  srv.request.position = static_cast<int16_t>(pos < -32768 ? -32768 : pos > 32767 ? 32767 : pos);
+  call("set_turret", srv, "setTurretRotation");
+}
+
+int getTurretRotation(void) {
+  sbot_msgs::TurretState s;
+  if (!ready("getTurretRotation") || !g->turret.get(*g->nh, &s)) return 0;
+  return s.rotation;
+}
+
+int getTurretRotationTorque(void) {
+  sbot_msgs::TurretState s;
+  if (!ready("getTurretRotationTorque") || !g->turret.get(*g->nh, &s)) return 0;
+  return s.torque;
+}
+
+void setGripperElevation(int elevation) {
+  if (!ready("setGripperElevation")) return;
+  std::lock_guard<std::mutex> l(g->cmd_m);
+  knowGripper();
+  g->gripper_elevation = elevation < -32768 ? -32768 : elevation > 32767 ? 32767 : elevation;
+  gripperCommand("setGripperElevation");
+}
+
+int getGripperElevation(void) {
+  sbot_msgs::GripperState s;
+  if (!ready("getGripperElevation") || !g->gripper.get(*g->nh, &s)) return 0;
+  return s.elevation;
+}
+
+void setGripperAperture(int aperture) {
+  if (!ready("setGripperAperture")) return;
+  std::lock_guard<std::mutex> l(g->cmd_m);
+  knowGripper();
+  g->gripper_aperture = aperture < -32768 ? -32768 : aperture > 32767 ? 32767 : aperture;
+  gripperCommand("setGripperAperture");
+}
+
+int getGripperAperture(void) {
+  sbot_msgs::GripperState s;
+  if (!ready("getGripperAperture") || !g->gripper.get(*g->nh, &s)) return 0;
+  return s.aperture;
+}
+
+int getGripperElevationTorque(void) {
+  sbot_msgs::GripperState s;
+  if (!ready("getGripperElevationTorque") || !g->gripper.get(*g->nh, &s)) return 0;
+  return s.elevation_torque;
+}
+
+void getGripperOpticalBarrier(unsigned* internal, unsigned* external, unsigned* combined) {
+  sbot_msgs::GripperState s;
+  if (!ready("getGripperOpticalBarrier") || !g->gripper.get(*g->nh, &s)) return;
+  if (internal) *internal = s.barrier_internal;
+  if (external) *external = s.barrier_external;
+  if (combined) *combined = s.barrier_combined;
+}
+
+void setSideArmPos(int elevation, int rotation, int depth) {
+  if (!ready("setSideArmPos")) return;
+  std::lock_guard<std::mutex> l(g->cmd_m);
+  g->arm_known = true;
+  g->arm_e = elevation;
+  g->arm_r = rotation;
+  g->arm_d = depth;
+  armCommand(sbot_msgs::SetSideArm::Request::JAWS_KEEP, "setSideArmPos");
+}
+
+void getSideArmPos(int* elevation, int* rotation, int* depth) {
+  sbot_msgs::SideArmState s;
+  if (!ready("getSideArmPos") || !g->side_arm.get(*g->nh, &s)) return;
+  if (elevation) *elevation = s.elevation;
+  if (rotation) *rotation = s.rotation;
+  if (depth) *depth = s.depth;
+}
+
+void getSideArmTorque(int* elevation, int* rotation, int* depth) {
+  sbot_msgs::SideArmState s;
+  if (!ready("getSideArmTorque") || !g->side_arm.get(*g->nh, &s)) return;
+  if (elevation) *elevation = s.torque_elevation;
+  if (rotation) *rotation = s.torque_rotation;
+  if (depth) *depth = s.torque_depth;
+}
+
+void setSideArmOpened(void) {
+  if (!ready("setSideArmOpened")) return;
+  std::lock_guard<std::mutex> l(g->cmd_m);
+  knowArm();
+  armCommand(sbot_msgs::SetSideArm::Request::JAWS_OPEN, "setSideArmOpened");
+}
+
+void setSideArmClosed(void) {
+  if (!ready("setSideArmClosed")) return;
+  std::lock_guard<std::mutex> l(g->cmd_m);
+  knowArm();
+  armCommand(sbot_msgs::SetSideArm::Request::JAWS_CLOSE, "setSideArmClosed");
+}
+
+void getSideArmOpticalBarrier(unsigned* internal, unsigned* external, unsigned* combined) {
+  sbot_msgs::SideArmState s;
+  if (!ready("getSideArmOpticalBarrier") || !g->side_arm.get(*g->nh, &s)) return;
+  if (internal) *internal = s.barrier_internal;
+  if (external) *external = s.barrier_external;
+  if (combined) *combined = s.barrier_combined;
+}
+
+unsigned getProximitySensor(unsigned sensor) {
+  if (sensor > 14) {
+    report(false, "getProximitySensor(%u): sensor outside [0, 14]", sensor);
+    return 0;
+  }
+  sbot_msgs::ProximityArray s;
+  if (!ready("getProximitySensor") || !g->proximity.get(*g->nh, &s, true, sensor)) return 0;
+  return s.readings[sensor];
+}
+
+void getAllProximitySensors(unsigned sensors[15]) {
+  sbot_msgs::ProximityArray s;
+  if (!ready("getAllProximitySensors") || !g->proximity.get(*g->nh, &s, true)) {
+    for (int k = 0; k < 15; ++k) sensors[k] = 0;
+    return;
+  }
+  for (int k = 0; k < 15; ++k) sensors[k] = s.readings[k];
+}
+
+void setProximitySamplingRate(SamplingRate rate) { setRate("proximity", rate, "setProximitySamplingRate"); }
+
+unsigned getGroundSensor(unsigned sensor) {
+  if (sensor > 3) {
+    report(false, "getGroundSensor(%u): sensor outside [0, 3]", sensor);
+    return 0;
+  }
+  sbot_msgs::GroundArray s;
+  if (!ready("getGroundSensor") || !g->ground.get(*g->nh, &s, true, sensor)) return 0;
+  return s.readings[sensor];
+}
+
+void getAllGroundSensors(unsigned sensors[4]) {
+  sbot_msgs::GroundArray s;
+  if (!ready("getAllGroundSensors") || !g->ground.get(*g->nh, &s, true)) {
+    for (int k = 0; k < 4; ++k) sensors[k] = 0;
+    return;
+  }
+  for (int k = 0; k < 4; ++k) sensors[k] = s.readings[k];
+}
+
+void setGroundSamplingRate(SamplingRate rate) { setRate("ground", rate, "setGroundSamplingRate"); }
+
+unsigned getLightSensor(unsigned sensor) {
+  if (sensor > 7) {
+    report(false, "getLightSensor(%u): sensor outside [0, 7]", sensor);
+    return 0;
+  }
+  sbot_msgs::LightArray s;
+  if (!ready("getLightSensor") || !g->light.get(*g->nh, &s, true, sensor)) return 0;
+  return s.readings[sensor];
+}
+
+void getAllLightSensors(unsigned sensors[8]) {
+  sbot_msgs::LightArray s;
+  if (!ready("getAllLightSensors") || !g->light.get(*g->nh, &s, true)) {
+    for (int k = 0; k < 8; ++k) sensors[k] = 0;
+    return;
+  }
+  for (int k = 0; k < 8; ++k) sensors[k] = s.readings[k];
+}
+
+void setLightColor(unsigned light, unsigned r, unsigned gr, unsigned b, BlinkingRate blink) {
+  leds({light}, &r, &gr, &b, &blink, true, "setLightColor");
+}
+
+void setAllLightColor(unsigned r[8], unsigned gr[8], unsigned b[8], BlinkingRate blink[8]) {
+  leds({0, 1, 2, 3, 4, 5, 6, 7}, r, gr, b, blink, false, "setAllLightColor");
+}
+
+void setSameLightColor(unsigned r, unsigned gr, unsigned b, BlinkingRate blink) {
+  leds({0, 1, 2, 3, 4, 5, 6, 7}, &r, &gr, &b, &blink, true, "setSameLightColor");
+}
+
+void setLightSamplingRate(SamplingRate rate) { setRate("light", rate, "setLightSamplingRate"); }
+
+void getTemperatureAndHumidityLeft(float* temperature, float* humidity) {
+  sbot_msgs::Climate s;
+  if (!ready("getTemperatureAndHumidityLeft") || !g->climate.get(*g->nh, &s)) return;
+  if (temperature) *temperature = s.temperature_left;
+  if (humidity) *humidity = s.humidity_left;
+}
+
+void getTemperatureAndHumidityRight(float* temperature, float* humidity) {
+  sbot_msgs::Climate s;
+  if (!ready("getTemperatureAndHumidityRight") || !g->climate.get(*g->nh, &s)) return;
+  if (temperature) *temperature = s.temperature_right;
+  if (humidity) *humidity = s.humidity_right;
+}
+
+void getSlope(int* pitch, int* roll) {
+  sbot_msgs::Slope s;
+  if (!ready("getSlope") || !g->slope.get(*g->nh, &s, true)) return;
+  if (pitch) *pitch = s.pitch;
+  if (roll) *roll = s.roll;
+}
+
+void setSlopeSamplingRate(SamplingRate rate) { setRate("slope", rate, "setSlopeSamplingRate"); }
+
+unsigned getBatteryVoltage(void) {
+  sbot_msgs::Battery s;
+  if (!ready("getBatteryVoltage") || !g->battery.get(*g->nh, &s)) return 0;
+  return s.voltage_units;
+}
+
+void playMusic(const char* filename) {
+  if (!ready("playMusic")) return;
+  std::uint32_t h = 2166136261u;  // FNV-1a
+  for (const char* p = filename ? filename : ""; *p; ++p) h = (h ^ static_cast<unsigned char>(*p)) * 16777619u;
+  std_msgs::Float64 m;
+  m.data = 200.0 + static_cast<double>(h % 1800u);
+  g->speaker_pub.publish(m);
+}
+
+void stopMusic(void) {
+  if (!ready("stopMusic")) return;
+  std_msgs::Float64 m;
+  m.data = 0;
+  g->speaker_pub.publish(m);
+}
+
+}  // extern "C"

@@ -1,0 +1,149 @@
+#include "sbot_sim/core/effects/effects_file.h"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <set>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "sbot_sim/core/effects/effect_registry.h"
+#include "sbot_sim/core/errors.h"
+
+namespace sbot {
+namespace {
+
+std::string at(const YAML::Node& n) {
+  const YAML::Mark m = n.Mark();
+  if (m.line < 0) return "";
+  return " (line " + std::to_string(m.line + 1) + ", column " + std::to_string(m.column + 1) + ")";
+}
+
+std::map<std::string, double> numberMap(const YAML::Node& n, const std::string& field, const std::string& src) {
+  std::map<std::string, double> out;
+  if (!n || n.IsNull()) return out;
+  if (!n.IsMap()) throw ConfigError(src, field, "expected a mapping of name: number" + at(n));
+  for (const auto& kv : n) {
+    const std::string k = kv.first.as<std::string>();
+    double v;
+    try {
+      v = kv.second.as<double>();
+    } catch (const YAML::Exception&) {
+      const std::string text = kv.second.IsScalar() ? kv.second.as<std::string>() : "<not a scalar>";
+      throw ConfigError(src, field + "." + k, "expected a number, found '" + text + "'" + at(kv.second));
+    }
+    if (!std::isfinite(v)) throw ConfigError(src, field + "." + k, "must be a finite number" + at(kv.second));
+    out[k] = v;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<EffectConfig> parseEffectsConfig(const std::string& yaml_text, const std::string& src) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(src, "", "not valid YAML (line " + std::to_string(e.mark.line + 1) + "): " + e.msg);
+  }
+  std::vector<EffectConfig> out;
+  if (!root || root.IsNull()) return out;  // an empty file = no effects
+  if (!root.IsMap()) throw ConfigError(src, "", "expected a mapping with an 'effects' list");
+  for (const auto& kv : root) {
+    const std::string k = kv.first.as<std::string>();
+    if (k != "format" && k != "effects" && k != "name" && k != "description")
+      throw ConfigError(src, k, "unknown field (expected format, effects, name, description)" + at(kv.first));
+  }
+  if (root["format"] && root["format"].as<std::string>() != "sbot-effects/1")
+    throw ConfigError(src, "format", "unsupported format '" + root["format"].as<std::string>() +
+                                         "' (expected sbot-effects/1)");
+  const YAML::Node list = root["effects"];
+  if (!list || list.IsNull()) return out;
+  if (!list.IsSequence()) throw ConfigError(src, "effects", "expected a list" + at(list));
+  const EffectRegistry& reg = EffectRegistry::instance();
+  std::set<std::string> seen;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string field = "effects[" + std::to_string(i) + "]";
+    const YAML::Node e = list[i];
+    if (!e.IsMap()) throw ConfigError(src, field, "expected a mapping {name, params}" + at(e));
+    for (const auto& kv : e) {
+      const std::string k = kv.first.as<std::string>();
+      if (k != "name" && k != "params" && k != "stderr" && k != "note" && k != "ci95")
+        throw ConfigError(src, field + "." + k, "unknown field (expected name, params, stderr, ci95, note)" + at(kv.first));
+    }
+    if (!e["name"] || !e["name"].IsScalar()) throw ConfigError(src, field + ".name", "missing effect name" + at(e));
+    EffectConfig c;
+    c.name = e["name"].as<std::string>();
+    c.params = numberMap(e["params"], field + ".params", src);
+    c.stderr_ = numberMap(e["stderr"], field + ".stderr", src);
+    if (e["note"]) c.note = e["note"].as<std::string>();
+    if (!seen.insert(c.name).second) throw ConfigError(src, field + ".name", "effect '" + c.name + "' listed twice");
+    reg.create(c.name, c.params, src, field);  // validates name, parameter names and bounds
+    out.push_back(c);
+  }
+  return out;
+}
+
+std::vector<EffectConfig> loadEffectsConfig(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path, "", "cannot open effects file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parseEffectsConfig(ss.str(), path);
+}
+
+std::vector<EffectPtr> makeEffects(const std::vector<EffectConfig>& configs, const std::string& source) {
+  std::vector<EffectPtr> out;
+  const EffectRegistry& reg = EffectRegistry::instance();
+  for (std::size_t i = 0; i < configs.size(); ++i)
+    out.push_back(reg.create(configs[i].name, configs[i].params, source, "effects[" + std::to_string(i) + "]"));
+  return out;
+}
+
+std::vector<EffectPtr> loadEffectsFile(const std::string& path) { return makeEffects(loadEffectsConfig(path), path); }
+
+std::string effectsToYaml(const std::vector<EffectConfig>& configs, const std::string& header) {
+  std::ostringstream o;
+  if (!header.empty()) {
+    std::istringstream lines(header);
+    for (std::string l; std::getline(lines, l);) o << "# " << l << "\n";
+  }
+  o << "format: sbot-effects/1\n";
+  if (configs.empty()) {
+    o << "effects: []\n";
+    return o.str();
+  }
+  o << "effects:\n";
+  o << std::setprecision(8);
+  auto map = [&o](const std::map<std::string, double>& m) {
+    o << "{";
+    bool first = true;
+    for (const auto& [k, v] : m) {
+      o << (first ? "" : ", ") << k << ": " << v;
+      first = false;
+    }
+    o << "}";
+  };
+  for (const auto& c : configs) {
+    o << "  - name: " << c.name << "\n    params: ";
+    map(c.params);
+    o << "\n";
+    if (!c.stderr_.empty()) {
+      o << "    stderr: ";
+      map(c.stderr_);
+      o << "\n";
+    }
+    if (!c.note.empty()) o << "    note: " << YAML::Node(c.note) << "\n";
+  }
+  return o.str();
+}
+
+void writeEffectsFile(const std::string& path, const std::vector<EffectConfig>& configs, const std::string& header) {
+  std::ofstream out(path);
+  if (!out) throw ConfigError(path, "", "cannot write effects file");
+  out << effectsToYaml(configs, header);
+}
+
+}  // namespace sbot

@@ -1,0 +1,150 @@
+// The sensor and actuator modules of every robot on ROS: one sbot::sensors::Environment for the
+// world (lamps, ambient light, LED rings, speakers, climate), and per robot one SensorSuite, one
+// FrontGripper and one SideArm (core/sensors, core/actuators), with their topics and services in the
+// robot's namespace. Physics stays in the core; this class converts.
+//
+// Per robot <r> (topics published at their own rate [Hz, sim time], param ~rates/<channel>,
+// changeable at run time through <r>/set_sampling_rate; a topic nobody subscribes to is not computed):
+//   proximity            sbot_msgs/ProximityArray   ~rates/proximity (10)
+//   proximity/ir_<k>     sensor_msgs/Range          same rate, k = 0..14, only while subscribed
+//   ground               sbot_msgs/GroundArray      ~rates/ground (10)     Medium, Detailed
+//   light                sbot_msgs/LightArray       ~rates/light (10)      Medium, Detailed
+//   slope                sbot_msgs/Slope            ~rates/slope (10)
+//   imu                  sensor_msgs/Imu            ~rates/imu (10)   orientation + angular velocity
+//   sound                sbot_msgs/SoundState       ~rates/sound (10)
+//   camera/blobs         sbot_msgs/BlobArray        ~rates/camera (10)   fake camera
+//   gripper/state        sbot_msgs/GripperState     ~rates/gripper (10)
+//   side_arm/state       sbot_msgs/SideArmState     ~rates/side_arm (10)  Detailed only
+//   battery              sbot_msgs/Battery          ~rates/battery (1)
+//   climate              sbot_msgs/Climate          ~rates/climate (1)
+//   leds/state           sbot_msgs/LedState         ~rates/leds (10)
+//   sensor_markers       visualization_msgs/MarkerArray ~rates/markers (10): IR rays coloured by
+//                        reading, LED groups in their colours, the lamps (frame world)
+//   camera/image_raw     sensor_msgs/Image rgb8 + camera/camera_info (image_transport), ~rates/raw_camera
+//                        (5): the omnidirectional camera (sensors/raw_camera.h), ray-cast in software,
+//                        ~camera/width x ~camera/height (640 x 448), rendered at 1/~camera/internal_scale
+//                        (4) and upscaled; only rendered while subscribed
+//   sensors_available    sbot_msgs/SensorsAvailable latched
+//   leds                 sbot_msgs/LedState         command (subscribed): all 8 groups at once
+//   speaker              std_msgs/Float64           command: frequency [Hz], <= 0 = silence
+// Services: set_gripper, set_side_arm, set_leds, set_sampling_rate (sbot_msgs/Set*).
+// World: /sim/set_lamp, /sim/set_ambient_light; lamps and ambient light from the scenario YAML's
+// world.lamps [{position: [x,y,z], intensity: mcd, colour: [r,g,b]}] and world.ambient_light.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <image_transport/image_transport.h>
+#include <ros/ros.h>
+#include <sbot_msgs/LedState.h>
+#include <sbot_msgs/SetAmbientLight.h>
+#include <sbot_msgs/SetGripper.h>
+#include <sbot_msgs/SetLamp.h>
+#include <sbot_msgs/SetLeds.h>
+#include <sbot_msgs/SetSamplingRate.h>
+#include <sbot_msgs/SetSideArm.h>
+#include <std_msgs/Float64.h>
+
+#include "sbot_sim/core/actuators/gripper.h"
+#include "sbot_sim/core/actuators/side_arm.h"
+#include "sbot_sim/core/sensors/environment.h"
+#include "sbot_sim/core/sensors/raw_camera.h"
+#include "sbot_sim/core/sensors/sensor_suite.h"
+#include "sbot_sim/core/world.h"
+
+namespace sbot_node {
+
+/// Hz of an sbot.h SAMPLING_RATE_xx code (1..8); 0 for an unknown code.
+double samplingRateHz(unsigned code);
+
+struct LampSpec {
+  sbot::Vec3 position = sbot::Vec3::Zero();
+  double intensity = 0;
+  sbot::Vec3 colour = sbot::Vec3::Ones();
+};
+
+class RobotModulesRos {
+ public:
+  RobotModulesRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std::string& name);
+  ~RobotModulesRos();
+  void bind(sbot::World& world, sbot::sensors::Environment& env, sbot::Robot& robot);
+  void unbind();
+  bool bound() const { return robot_ != nullptr; }
+  const std::string& name() const { return name_; }
+  /// After every world step: module updates (battery, gripper, side arm) and due publications.
+  void update(double dt, double sim_time);
+  sbot::sensors::SensorSuite* suite() { return suite_.get(); }
+  sbot::actuators::FrontGripper* gripper() { return gripper_.get(); }
+
+ private:
+  struct Rate {
+    double hz = 10;
+    double next = 0;
+  };
+  bool due(const std::string& channel, double t);
+  void publishAvailable();
+  void publishMarkers(const ros::Time& stamp);
+  void publishRawCamera(const ros::Time& stamp);
+  void onLeds(const sbot_msgs::LedState::ConstPtr& msg);
+  void onSpeaker(const std_msgs::Float64::ConstPtr& msg);
+  bool onSetGripper(sbot_msgs::SetGripper::Request& req, sbot_msgs::SetGripper::Response& res);
+  bool onSetSideArm(sbot_msgs::SetSideArm::Request& req, sbot_msgs::SetSideArm::Response& res);
+  bool onSetLeds(sbot_msgs::SetLeds::Request& req, sbot_msgs::SetLeds::Response& res);
+  bool onSetSamplingRate(sbot_msgs::SetSamplingRate::Request& req, sbot_msgs::SetSamplingRate::Response& res);
+
+  ros::NodeHandle nh_, pnh_;
+  std::string name_;
+  sbot::World* world_ = nullptr;
+  sbot::sensors::Environment* env_ = nullptr;
+  sbot::Robot* robot_ = nullptr;
+  std::unique_ptr<sbot::sensors::SensorSuite> suite_;
+  std::unique_ptr<sbot::actuators::FrontGripper> gripper_;
+  std::unique_ptr<sbot::actuators::SideArm> side_arm_;
+  std::unique_ptr<sbot::sensors::RawCamera> raw_camera_;
+  sbot::sensors::RawCameraParams camera_params_;
+  image_transport::CameraPublisher camera_pub_;
+  std::map<std::string, Rate> rates_;
+  double next_any_ = 0;  ///< [s] earliest rates_[*].next
+  std::map<std::string, ros::Publisher> pubs_;
+  std::map<std::string, int> subs_;  ///< subscriber count per channel / "ir_<k>" (connect callbacks)
+  std::vector<ros::Publisher> ir_pubs_;
+  ros::Subscriber leds_sub_, speaker_sub_;
+  ros::ServiceServer set_gripper_srv_, set_side_arm_srv_, set_leds_srv_, set_rate_srv_;
+};
+
+class ModulesRosInterface {
+ public:
+  ModulesRosInterface(ros::NodeHandle nh, ros::NodeHandle pnh, std::unique_ptr<sbot::World>& world,
+                      const std::string& scenario_path);
+  ~ModulesRosInterface();
+  /// Build the Environment for the current world and bind every robot. Call after the world exists.
+  void attach();
+  /// Drop every module and the Environment. Call before the world is destroyed (reset, shutdown).
+  void detach();
+  /// After every World::step().
+  void afterStep(double sim_time);
+  // Hooks for spawn / delete / model switch (SwarmRosInterface).
+  void robotAdded(sbot::Robot& robot);
+  void robotRemoving(sbot::Robot& robot);
+  void robotRebuilt(sbot::Robot& robot);
+  sbot::sensors::Environment* environment() { return env_.get(); }
+
+ private:
+  bool onSetLamp(sbot_msgs::SetLamp::Request& req, sbot_msgs::SetLamp::Response& res);
+  bool onSetAmbient(sbot_msgs::SetAmbientLight::Request& req, sbot_msgs::SetAmbientLight::Response& res);
+  RobotModulesRos& modulesFor(const std::string& name);
+
+  ros::NodeHandle nh_, pnh_;
+  std::unique_ptr<sbot::World>& world_;
+  sbot::World* bound_world_ = nullptr;
+  std::vector<LampSpec> lamps_;
+  double ambient_ = 0;
+  std::unique_ptr<sbot::sensors::Environment> env_;
+  std::map<std::string, std::unique_ptr<RobotModulesRos>> robots_;
+  ros::ServiceServer set_lamp_srv_, set_ambient_srv_;
+};
+
+}  // namespace sbot_node

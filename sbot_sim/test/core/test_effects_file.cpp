@@ -1,0 +1,79 @@
+// Effects files (effects_file.h): the format the workbench writes and the simulator loads; every
+// bad file is a ConfigError naming the file and the field.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+
+#include "sbot_sim/core/effects/effect_registry.h"
+#include "sbot_sim/core/effects/effects_file.h"
+#include "sbot_sim/core/errors.h"
+
+namespace sbot::test {
+namespace {
+
+std::string fieldOf(const std::string& yaml) {
+  try {
+    parseEffectsConfig(yaml, "effects.yaml");
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.file(), "effects.yaml");
+    return e.field();
+  }
+  return "<no error>";
+}
+
+TEST(EffectsFile, ParsesAndInstantiates) {
+  const auto cfg = parseEffectsConfig(
+      "format: sbot-effects/1\n"
+      "effects:\n"
+      "  - name: speed_scale\n"
+      "    params: {scale: 1.04}\n"
+      "    stderr: {scale: 0.002}\n"
+      "  - {name: latency, params: {delay: 0.05}, note: fitted}\n",
+      "effects.yaml");
+  ASSERT_EQ(cfg.size(), 2u);
+  EXPECT_EQ(cfg[0].name, "speed_scale");
+  EXPECT_DOUBLE_EQ(cfg[0].params.at("scale"), 1.04);
+  EXPECT_DOUBLE_EQ(cfg[0].stderr_.at("scale"), 0.002);
+  EXPECT_EQ(cfg[1].note, "fitted");
+  const auto effects = makeEffects(cfg);
+  ASSERT_EQ(effects.size(), 2u);
+  EXPECT_EQ(effects[1]->name(), "latency");
+  auto* p = dynamic_cast<ParametricEffect*>(effects[1].get());
+  ASSERT_NE(p, nullptr);
+  EXPECT_DOUBLE_EQ(p->param("delay"), 0.05);
+  EXPECT_TRUE(parseEffectsConfig("", "empty.yaml").empty()) << "an empty file means no effects";
+  EXPECT_TRUE(parseEffectsConfig("effects: []", "e.yaml").empty());
+}
+
+TEST(EffectsFile, ErrorsNameTheField) {
+  EXPECT_EQ(fieldOf("effects: [{name: warp_drive}]"), "effects[0].name");
+  EXPECT_EQ(fieldOf("effects: [{name: speed_scale, params: {radius: 1}}]"), "effects[0].params.radius");
+  EXPECT_EQ(fieldOf("effects: [{name: speed_scale, params: {scale: fast}}]"), "effects[0].params.scale");
+  EXPECT_EQ(fieldOf("effects: [{name: speed_scale}, {name: latency, params: {delay: -1}}]"), "effects[1].params.delay");
+  EXPECT_EQ(fieldOf("effects: [{params: {scale: 1}}]"), "effects[0].name");
+  EXPECT_EQ(fieldOf("effects: [{name: latency}, {name: latency}]"), "effects[1].name");
+  EXPECT_EQ(fieldOf("effects: [{name: latency, colour: red}]"), "effects[0].colour");
+  EXPECT_EQ(fieldOf("effects: {name: latency}"), "effects");
+  EXPECT_EQ(fieldOf("effect: []"), "effect");
+  EXPECT_EQ(fieldOf("format: sbot-effects/9\neffects: []"), "format");
+  EXPECT_EQ(fieldOf("effects: [{name: latency"), "") << "YAML syntax errors name the file";
+  EXPECT_THROW(loadEffectsFile("/nonexistent/effects.yaml"), ConfigError);
+}
+
+TEST(EffectsFile, WriteThenReadRoundTrips) {
+  const std::vector<EffectConfig> cfg{{"speed_scale", {{"scale", 1.0371}}, {{"scale", 0.0012}}, "note: with a colon"},
+                                      {"motor_lag", {{"tau", 0.125}}, {}, ""}};
+  const std::string path = testing::TempDir() + "effects_roundtrip.yaml";
+  writeEffectsFile(path, cfg, "written by a test\nsecond line");
+  const auto back = loadEffectsConfig(path);
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_DOUBLE_EQ(back[0].params.at("scale"), 1.0371);
+  EXPECT_DOUBLE_EQ(back[0].stderr_.at("scale"), 0.0012);
+  EXPECT_EQ(back[0].note, "note: with a colon");
+  EXPECT_DOUBLE_EQ(back[1].params.at("tau"), 0.125);
+  std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace sbot::test

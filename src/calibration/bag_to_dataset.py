@@ -1,0 +1,193 @@
+#!/usr/bin/python3
+"""Convert recorded rosbags into a measurement dataset (format sbot-dataset/1, docs/calibration.md).
+
+    rosrun swarmbot3d bag_to_dataset.py OUT_DIR BAG [BAG ...] [options]
+
+Each bag becomes one `drive` run (named after the bag file, or --run-name for a single bag). Read,
+per robot namespace ROBOT (--robot, default sbot_0), with every topic overridable:
+
+  commands   /ROBOT/cmd_speed    sbot_msgs/TrackSpeed (left, right) -> cmd_left, cmd_right
+  tracker    /ROBOT/ground_truth nav_msgs/Odometry, or geometry_msgs/PoseStamped | Pose2D |
+                                 PoseWithCovarianceStamped (e.g. an overhead camera) -> x, y, yaw
+  tracks     /ROBOT/track_state  sbot_msgs/TrackState -> speed_left/right, torque_left/right
+  slope      /ROBOT/slope        sbot_msgs/Slope (deg) -> pitch, roll (rad)
+  proximity  /ROBOT/proximity    sbot_msgs/ProximityArray -> ir0..ir14
+  ground     /ROBOT/ground       sbot_msgs/GroundArray -> ground0..ground3
+  light      /ROBOT/light        sbot_msgs/LightArray -> light0..light7
+
+Time stamps come from message headers when present (bag time otherwise) and are relative to the
+first message of the run. Topics that are absent are simply not measured. The start pose is the
+first tracker pose. The world (obstacles, lamps) is copied from --world (a YAML file with the
+dataset's `world:` mapping) and the model level from --level. With --append, runs are added to an
+existing dataset. Message classes are taken from the bag itself, so the workspace need not be sourced.
+"""
+import argparse
+import math
+import os
+import sys
+
+import rosbag
+import yaml
+
+
+def quat_yaw(q):
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def stamp_of(msg, bag_time):
+    h = getattr(msg, "header", None)
+    if h is not None and (h.stamp.secs or h.stamp.nsecs):
+        return h.stamp.to_sec()
+    return bag_time.to_sec()
+
+
+def tracker_pose(msg):
+    """(x, y, yaw) from the supported tracker message types, None if unsupported."""
+    t = msg._type
+    if t == "nav_msgs/Odometry":
+        p = msg.pose.pose
+    elif t == "geometry_msgs/PoseWithCovarianceStamped":
+        p = msg.pose.pose
+    elif t == "geometry_msgs/PoseStamped":
+        p = msg.pose
+    elif t == "geometry_msgs/Pose":
+        p = msg
+    elif t == "geometry_msgs/Pose2D":
+        return msg.x, msg.y, msg.theta
+    else:
+        return None
+    return p.position.x, p.position.y, quat_yaw(p.orientation)
+
+
+def read_run(bag_path, topics):
+    """Rows {t: {column: value}} of one bag."""
+    rows = {}
+    first_pose = None
+    t0 = None
+    wanted = [t for t in topics.values() if t]
+    with rosbag.Bag(bag_path) as bag:
+        present = set(bag.get_type_and_topic_info().topics.keys())
+        missing = [k for k, t in topics.items() if t and t not in present]
+        for topic, msg, bt in bag.read_messages(topics=wanted):
+            t = stamp_of(msg, bt)
+            if t0 is None:
+                t0 = t
+            key = round(t - t0, 6)
+            row = rows.setdefault(key, {})
+            if topic == topics["commands"]:
+                row["cmd_left"], row["cmd_right"] = msg.left, msg.right
+            elif topic == topics["tracker"]:
+                pose = tracker_pose(msg)
+                if pose is None:
+                    raise SystemExit("%s: tracker topic %s has unsupported type %s" % (bag_path, topic, msg._type))
+                row["x"], row["y"], row["yaw"] = pose
+                if first_pose is None:
+                    first_pose = pose
+            elif topic == topics["tracks"]:
+                row["speed_left"], row["speed_right"] = msg.measured_left, msg.measured_right
+                row["torque_left"], row["torque_right"] = msg.torque_left, msg.torque_right
+            elif topic == topics["slope"]:
+                row["pitch"], row["roll"] = math.radians(msg.pitch), math.radians(msg.roll)
+            elif topic == topics["proximity"]:
+                for k, v in enumerate(msg.readings):
+                    row["ir%d" % k] = v
+            elif topic == topics["ground"]:
+                for k, v in enumerate(msg.readings):
+                    row["ground%d" % k] = v
+            elif topic == topics["light"]:
+                for k, v in enumerate(msg.readings):
+                    row["light%d" % k] = v
+    return rows, first_pose, missing
+
+
+ORDER = ["cmd_left", "cmd_right", "x", "y", "yaw", "speed_left", "speed_right", "torque_left", "torque_right",
+         "pitch", "roll"] + ["ir%d" % k for k in range(15)] + ["ground%d" % k for k in range(4)] + \
+        ["light%d" % k for k in range(8)]
+
+
+def write_csv(path, rows):
+    cols = [c for c in ORDER if any(c in r for r in rows.values())]
+    if "cmd_left" not in cols:
+        raise SystemExit("%s: no command messages: a drive run needs the command topic" % path)
+    measured = [c for c in cols if c not in ("cmd_left", "cmd_right")]
+    if not measured:
+        raise SystemExit("%s: nothing measured (no tracker, track state or sensor topic in the bag)" % path)
+    with open(path, "w") as f:
+        f.write("t," + ",".join(cols) + "\n")
+        for t in sorted(rows):
+            r = rows[t]
+            cells = []
+            for c in cols:
+                v = r.get(c)
+                cells.append("" if v is None else ("%.10g" % v))
+            # commands are given as a pair or not at all
+            f.write("%.6f," % t + ",".join(cells) + "\n")
+    return cols
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("out", help="dataset directory (created)")
+    p.add_argument("bags", nargs="+", help="bag files, one run each")
+    p.add_argument("--robot", default="sbot_0", help="robot namespace (default sbot_0)")
+    p.add_argument("--level", default="medium", help="model level of the dataset (default medium)")
+    p.add_argument("--name", default=None, help="dataset name (default: the directory name)")
+    p.add_argument("--run-name", default=None, help="run name (single bag only)")
+    p.add_argument("--world", default=None, help="YAML file with the dataset's world mapping")
+    p.add_argument("--append", action="store_true", help="add the runs to an existing dataset")
+    for key, default in (("commands", "cmd_speed"), ("tracker", "ground_truth"), ("tracks", "track_state"),
+                         ("slope", "slope"), ("proximity", "proximity"), ("ground", "ground"), ("light", "light")):
+        p.add_argument("--%s-topic" % key, default=None,
+                       help="%s topic (default /ROBOT/%s; 'none' to ignore)" % (key, default))
+    a = p.parse_args(argv)
+    defaults = {"commands": "cmd_speed", "tracker": "ground_truth", "tracks": "track_state", "slope": "slope",
+                "proximity": "proximity", "ground": "ground", "light": "light"}
+    topics = {}
+    for k, d in defaults.items():
+        v = getattr(a, "%s_topic" % k)
+        topics[k] = None if v == "none" else (v or "/%s/%s" % (a.robot, d))
+    if a.run_name and len(a.bags) > 1:
+        raise SystemExit("--run-name needs a single bag")
+
+    os.makedirs(a.out, exist_ok=True)
+    yaml_path = os.path.join(a.out, "dataset.yaml")
+    if a.append and os.path.exists(yaml_path):
+        with open(yaml_path) as f:
+            ds = yaml.safe_load(f)
+    else:
+        ds = {"format": "sbot-dataset/1", "name": a.name or os.path.basename(os.path.abspath(a.out)),
+              "description": "imported from rosbag by bag_to_dataset.py", "robot": a.level,
+              "world": {"terrain": {"type": "plane"}}, "runs": []}
+    if a.world:
+        with open(a.world) as f:
+            w = yaml.safe_load(f)
+        ds["world"] = w.get("world", w)
+    names = {r["name"] for r in ds["runs"]}
+    for bag in a.bags:
+        name = a.run_name or os.path.splitext(os.path.basename(bag))[0]
+        base, k = name, 2
+        while name in names:
+            name = "%s_%d" % (base, k)
+            k += 1
+        rows, pose, missing = read_run(bag, topics)
+        if not rows:
+            raise SystemExit("%s: none of the topics %s is in the bag" % (bag, sorted(t for t in topics.values() if t)))
+        cols = write_csv(os.path.join(a.out, name + ".csv"), rows)
+        run = {"name": name, "file": name + ".csv", "kind": "drive",
+               "initial_pose": {"x": pose[0], "y": pose[1], "yaw": pose[2]} if pose else {"x": 0.0, "y": 0.0, "yaw": 0.0}}
+        ds["runs"].append(run)
+        names.add(name)
+        sys.stdout.write("%s -> %s.csv: %d rows, columns %s%s\n" % (
+            bag, name, len(rows), ",".join(cols),
+            ("; topics not in the bag: " + ", ".join(missing)) if missing else ""))
+        if pose is None:
+            sys.stdout.write("  warning: no tracker pose: initial_pose set to 0, 0, 0\n")
+    with open(yaml_path, "w") as f:
+        f.write("# sbot-dataset/1 (see docs/calibration.md)\n")
+        yaml.safe_dump(ds, f, default_flow_style=None, sort_keys=False)
+    sys.stdout.write("wrote %s (%d runs)\n" % (yaml_path, len(ds["runs"])))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,161 @@
+#include "calibration/evaluation.h"
+
+#include "calibration/codec.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sbot::calib {
+
+double Evaluation::rss() const {
+  double s = 0;
+  for (const auto& r : runs) s += r.rss;
+  return s;
+}
+
+std::size_t Evaluation::n() const {
+  std::size_t s = 0;
+  for (const auto& r : runs) s += r.n;
+  return s;
+}
+
+Eigen::VectorXd Evaluation::stacked() const {
+  std::size_t len = 0;
+  for (const auto& r : runs) len += r.r.size();
+  Eigen::VectorXd v(len);
+  std::size_t k = 0;
+  for (const auto& r : runs)
+    for (double x : r.r) v(k++) = x;
+  return v;
+}
+
+double huberLoss(double z, double c) {
+  const double a = std::abs(z);
+  return c > 0 && a > c ? 2 * c * a - c * c : z * z;
+}
+
+Eigen::VectorXd Evaluation::weights(double c) const {
+  std::size_t len = 0;
+  for (const auto& r : runs) len += r.r.size();
+  Eigen::VectorXd w(len);
+  std::size_t k = 0;
+  for (const auto& r : runs)
+    for (std::size_t i = 0; i < r.r.size(); ++i) {
+      const double a = std::abs(r.r[i]);
+      w(k++) = !r.valid[i] ? 0.0 : (c > 0 && a > c ? c / a : 1.0);
+    }
+  return w;
+}
+
+double Evaluation::rho1() const {
+  double num = 0, den = 0;
+  for (const auto& rr : runs) {
+    for (std::size_t c = 0; c < rr.channels.size(); ++c) {
+      double prev = 0, sxy = 0, sxx = 0;
+      bool have = false;
+      std::size_t m = 0;
+      for (std::size_t i = 0; i < rr.r.size(); ++i) {
+        if (rr.chan[i] != static_cast<int>(c) || !rr.valid[i]) continue;
+        const double x = std::max(-3.0, std::min(3.0, rr.r[i]));  // outliers clipped
+        if (have) sxy += prev * x;
+        sxx += x * x;
+        prev = x;
+        have = true;
+        ++m;
+      }
+      if (m < 3 || sxx <= 0) continue;
+      num += sxy / sxx * m;
+      den += m;
+    }
+  }
+  return den > 0 ? std::max(0.0, std::min(0.999, num / den)) : 0.0;
+}
+
+double Evaluation::nEffective() const {
+  const double rho = rho1();
+  return std::max(1.0, n() * (1 - rho) / (1 + rho));
+}
+
+std::vector<int> allRuns(const Dataset& ds) {
+  std::vector<int> v(ds.runs.size());
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = static_cast<int>(i);
+  return v;
+}
+
+std::set<std::string> usableGroups(const Dataset& ds) {
+  std::set<std::string> g;
+  for (const auto& c : ds.channels())
+    if (canSimulateChannel(c)) g.insert(NoiseModel::group(c));
+  return g;
+}
+
+RunResiduals residualsOf(const Dataset& ds, int run_index, const RunPrediction& p, const EvalOptions& opt) {
+  const Run& run = ds.runs[run_index];
+  RunResiduals out;
+  out.run = run_index;
+  for (const auto& [c, s] : run.channels) {
+    const std::string g = NoiseModel::group(c);
+    if (!opt.groups.empty() && !opt.groups.count(g)) continue;
+    if (!canSimulateChannel(c)) continue;
+    out.channels.push_back(c);
+  }
+  const double h = opt.huber;
+  for (std::size_t ci = 0; ci < out.channels.size(); ++ci) {
+    const std::string& c = out.channels[ci];
+    const Series& s = run.channels.at(c);
+    auto it = p.values.find(c);
+    // Yaw: unwrapped measurement against the (unwrapped) prediction, whole turns removed once.
+    std::vector<double> yaw_meas;
+    double yaw_turns = kNaN;
+    if (c == "yaw") yaw_meas = unwrapped(s);
+    for (std::size_t i = 0; i < s.v.size(); ++i) {
+      const double pred = it == p.values.end() ? kNaN : it->second[i];
+      out.chan.push_back(static_cast<int>(ci));
+      out.t.push_back(s.t[i]);
+      if (!std::isfinite(pred)) {
+        out.r.push_back(0);
+        out.raw.push_back(kNaN);
+        out.valid.push_back(0);
+        continue;
+      }
+      double e = s.v[i] - pred;
+      if (c == "yaw") {
+        e = yaw_meas[i] - pred;
+        if (std::isnan(yaw_turns)) yaw_turns = 2 * M_PI * std::round(e / (2 * M_PI));
+        e -= yaw_turns;
+      }
+      const double z = e / ds.noise.sigma(c, s.v[i]);
+      out.r.push_back(z);
+      out.raw.push_back(e);
+      out.valid.push_back(1);
+      out.rss += huberLoss(z, h);
+      ++out.n;
+    }
+  }
+  return out;
+}
+
+Evaluation evaluate(const Dataset& ds, const ModelSpec& model, const std::vector<int>& runs, const EvalOptions& opt,
+                    WorkerPool& pool) {
+  Evaluation ev;
+  // Longest runs first for load balance.
+  std::vector<std::size_t> order(runs.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return ds.runs[runs[a]].t_end > ds.runs[runs[b]].t_end;
+  });
+  ReplayOptions ro = opt.replay;
+  ro.world_override = opt.world_override;
+  auto res = pool.map<RunResiduals>(order.size(), [&](std::size_t k) {
+    const std::size_t i = order[k];
+    RunPrediction p = replayRun(ds, ds.runs[runs[i]], model, ro);
+    RunResiduals rr = residualsOf(ds, runs[i], p, opt);
+    if (ro.keep_trace) rr.prediction = std::move(p);
+    return rr;
+  });
+  ev.runs.resize(runs.size());
+  for (std::size_t k = 0; k < order.size(); ++k) ev.runs[order[k]] = std::move(res[k]);
+  return ev;
+}
+
+}  // namespace sbot::calib

@@ -1,0 +1,65 @@
+// Residuals of a model against a dataset: every measured sample becomes one normalised residual
+// (measured - predicted) / sigma(channel), passed through a Huber loss so IR outliers cannot dominate.
+// Channels can then be combined: a correct model gives a mean square of ~1 (the noise floor).
+#pragma once
+
+#include <set>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "calibration/dataset.h"
+#include "calibration/parallel.h"
+#include "calibration/replay.h"
+
+namespace sbot::calib {
+
+struct EvalOptions {
+  double huber = 3.0;                 ///< Huber threshold in sigmas (<= 0: plain least squares)
+  std::set<std::string> groups;       ///< channel groups to use (empty = every simulated group)
+  ReplayOptions replay;
+  const WorldConfig* world_override = nullptr;  ///< generator truth (tests only)
+};
+
+struct RunResiduals {
+  int run = -1;
+  std::vector<std::string> channels;  ///< channels used, sorted
+  std::vector<int> chan;              ///< per residual: index into channels
+  std::vector<double> t;              ///< per residual: time stamp (or placement row)
+  std::vector<double> r;              ///< normalised residual (measured - predicted) / sigma (0 where not simulated)
+  std::vector<double> raw;            ///< measured - predicted in channel units (yaw wrapped)
+  std::vector<char> valid;
+  double rss = 0;                     ///< robust sum: sum of huberLoss(r) (= sum r^2 without outliers)
+  std::size_t n = 0;
+  RunPrediction prediction;           ///< kept when EvalOptions::replay.keep_trace
+};
+
+struct Evaluation {
+  std::vector<RunResiduals> runs;
+  double rss() const;
+  std::size_t n() const;
+  Eigen::VectorXd stacked() const;
+  /// IRLS weights of the Huber loss at these residuals (0 for samples that were not simulated).
+  Eigen::VectorXd weights(double huber) const;
+  /// Mean lag-1 autocorrelation of the residuals within each (run, channel) series, sample-weighted.
+  double rho1() const;
+  /// Effective number of independent samples n (1 - rho) / (1 + rho) (AR(1) approximation).
+  double nEffective() const;
+  double rmsNormalised() const { return n() ? std::sqrt(rss() / n()) : 0.0; }
+};
+
+/// Huber loss scaled like a square: z^2 inside [-c, c], 2c|z| - c^2 outside.
+double huberLoss(double z, double c);
+
+/// Replay `runs` (indices into ds.runs) in parallel and compute their residuals.
+Evaluation evaluate(const Dataset& ds, const ModelSpec& model, const std::vector<int>& runs, const EvalOptions& opt,
+                    WorkerPool& pool);
+RunResiduals residualsOf(const Dataset& ds, int run_index, const RunPrediction& p, const EvalOptions& opt);
+
+/// Channel groups the current build can simulate and the dataset measures.
+std::set<std::string> usableGroups(const Dataset& ds);
+
+std::vector<int> allRuns(const Dataset& ds);
+
+}  // namespace sbot::calib

@@ -1,0 +1,288 @@
+#include "calibration/sweep.h"
+
+#include "calibration/codec.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <mutex>
+#include <sstream>
+
+namespace sbot::calib {
+namespace {
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  for (std::string x; std::getline(ss, x, sep);)
+    if (!x.empty()) out.push_back(x);
+  return out;
+}
+
+std::string pct(double f) {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(0) << 100 * f << " %";
+  return o.str();
+}
+
+}  // namespace
+
+void save(Writer& w, const SeedOutcome& o) {
+  save(w, o.seed);
+  save(w, o.accepted);
+  save(w, o.estimate);
+  save(w, o.truth);
+  save(w, o.rms_before);
+  save(w, o.rms_after);
+  save(w, o.floor);
+  save(w, o.structure_flagged);
+  save(w, o.seconds);
+  save(w, o.verdict);
+}
+void load(Reader& r, SeedOutcome& o) {
+  load(r, o.seed);
+  load(r, o.accepted);
+  load(r, o.estimate);
+  load(r, o.truth);
+  load(r, o.rms_before);
+  load(r, o.rms_after);
+  load(r, o.floor);
+  load(r, o.structure_flagged);
+  load(r, o.seconds);
+  load(r, o.verdict);
+}
+
+std::vector<SweepCase> standardCases(const std::string&) {
+  using K = SweepCase::Kind;
+  std::vector<SweepCase> c;
+  auto single = [&](const std::string& e, const std::string& p, double v) {
+    c.push_back({e, {{e, {{p, v}}, {}, ""}}, 0, K::Single});
+  };
+  single("speed_scale", "scale", 1.06);
+  single("motor_asymmetry", "asymmetry", 0.03);
+  single("track_width", "ratio", 1.25);
+  single("turn_skid", "k", 0.15);
+  single("latency", "delay", 0.15);
+  single("dead_band", "threshold", 0.015);
+  single("motor_lag", "tau", 0.2);
+  single("accel_limit", "ramp_time", 1.0);
+  single("battery_sag", "rate", 0.04);
+  // Effects that need the six-wheel model and/or torque readings (Medium, torque logged).
+  auto medium = [&](const std::string& e, const std::string& p, double v) {
+    c.push_back({e, {{e, {{p, v}}, {}, ""}}, 0, K::Single, "medium", {}, true});
+  };
+  medium("rolling_resistance", "coefficient", 0.2);
+  medium("torque_saturation", "scale", 0.3);
+  medium("track_friction_anisotropy", "lateral_ratio", 0.5);
+  c.push_back({"none_medium", {}, 0, K::None, "medium", {}, true});
+  // Sensor effects: static IR placements in front of three surfaces, Medium model (ray-traced IR).
+  auto sensor = [&](const std::string& e, const std::string& p, double v) {
+    c.push_back({e, {{e, {{p, v}}, {}, ""}}, 0, K::Single, "medium", {"place"}});
+  };
+  sensor("ir_reflectance", "black_card", 0.3);
+  sensor("ir_incidence", "exponent", 2.0);
+  sensor("ir_ambient", "offset", 20.0);
+  c.push_back({"none_ir", {}, 0, K::None, "medium", {"place"}});
+  c.push_back({"none", {}, 0, K::None});
+  c.push_back({"tilt2", {}, 2.0, K::Outside});
+  c.push_back({"speed_scale+latency",
+               {{"speed_scale", {{"scale", 1.06}}, {}, ""}, {"latency", {{"delay", 0.15}}, {}, ""}},
+               0,
+               K::Pair});
+  c.push_back({"motor_asymmetry+track_width",
+               {{"motor_asymmetry", {{"asymmetry", 0.03}}, {}, ""}, {"track_width", {{"ratio", 1.25}}, {}, ""}},
+               0,
+               K::Pair});
+  return c;
+}
+
+std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool) {
+  std::vector<CaseSummary> out(opt.cases.size());
+  struct Job {
+    std::size_t c;
+    int s;
+  };
+  std::vector<Job> jobs;
+  for (std::size_t c = 0; c < opt.cases.size(); ++c) {
+    out[c].c = opt.cases[c];
+    out[c].seeds.resize(opt.seeds);
+    for (int s = 0; s < opt.seeds; ++s) jobs.push_back({c, s});
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  auto outcomes = pool.map<SeedOutcome>(jobs.size(), [&](std::size_t j) {
+    const Job job = jobs[j];
+    const SweepCase& sc = opt.cases[job.c];
+    SeedOutcome o;
+    o.seed = opt.first_seed + job.s;
+    GeneratorOptions g = opt.gen;
+    if (!sc.level.empty()) g.level = sc.level;
+    if (!sc.families.empty()) g.experiments = sc.families;
+    if (sc.torque) g.measure_torque = true;
+    g.seed = o.seed * 1000 + job.c;
+    g.hidden = sc.hidden;
+    g.tilt_deg = sc.tilt_deg;
+    g.name = sc.name;
+    GeneratedTruth truth;
+    const Dataset ds = generateDataset(g, pool, &truth);
+    DiagnoseOptions d = opt.diag;
+    d.progress = false;
+    d.seed = o.seed;
+    d.base.level = g.level;
+    const auto ts = std::chrono::steady_clock::now();
+    const DiagnoseResult r = diagnose(ds, d, pool);
+    o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ts).count();
+    o.accepted = r.accepted;
+    o.rms_before = r.heldout_rms_before;
+    o.rms_after = r.heldout_rms_after;
+    o.structure_flagged = r.structure_flagged;
+    o.verdict = r.verdict;
+    for (std::size_t k = 0; k < r.final_fit.free.size(); ++k) {
+      const auto& p = r.final_fit.free[k];
+      o.estimate[r.final_fit.model.effects[p.effect].name + "." + p.name] = r.final_fit.value[k];
+    }
+    for (const auto& h : sc.hidden)
+      for (const auto& [k, v] : h.params) o.truth[h.name + "." + k] = v;
+    // Noise floor: the true model (and world), replayed like any candidate.
+    EvalOptions eo = d.fit.eval;
+    eo.world_override = &truth.world;
+    eo.replay.tilt = truth.tilt_deg * M_PI / 180;
+    eo.replay.tilt_direction = truth.tilt_direction;
+    const Evaluation fl = evaluate(ds, ModelSpec{g.level, sc.hidden}, allRuns(ds), eo, pool);
+    o.floor = fl.rmsNormalised();
+    if (opt.progress) {
+      const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      std::string acc;
+      for (const auto& a : o.accepted) acc += (acc.empty() ? "" : ",") + a;
+      std::fprintf(stderr, "[%6.0f s] %-28s seed %-3llu accepted {%s}  rms %.2f -> %.2f (floor %.2f)%s  %.0f s\n", secs,
+                   sc.name.c_str(), static_cast<unsigned long long>(o.seed), acc.c_str(), o.rms_before, o.rms_after,
+                   o.floor, o.structure_flagged ? " flagged" : "", o.seconds);
+    }
+    return o;
+  });
+  for (std::size_t j = 0; j < jobs.size(); ++j) out[jobs[j].c].seeds[jobs[j].s] = outcomes[j];
+  const EffectRegistry& reg = EffectRegistry::instance();
+  for (auto& cs : out) {
+    const double n = std::max<std::size_t>(1, cs.seeds.size());
+    for (const auto& o : cs.seeds) {
+      cs.mean_seconds += o.seconds / n;
+      const bool halved = o.rms_after <= 0.5 * o.rms_before;
+      const bool floor_ok = o.rms_after <= 1.2 * o.floor;
+      cs.at_floor += floor_ok / n;
+      switch (cs.c.kind) {
+        case SweepCase::Kind::Single: {
+          const std::string& e = cs.c.hidden.front().name;
+          const bool first = !o.accepted.empty() && o.accepted.front() == e;
+          cs.right_first += first / n;
+          bool within = first;
+          for (const auto& [key, tv] : o.truth) {
+            auto it = o.estimate.find(key);
+            const std::string pname = key.substr(key.find('.') + 1);
+            const double null = reg.info(e).findParam(pname)->null_value;
+            within &= it != o.estimate.end() && std::abs(it->second - tv) <= 0.1 * std::abs(tv - null);
+          }
+          cs.params_within += within / n;
+          cs.rmse_halved += halved / n;
+          break;
+        }
+        case SweepCase::Kind::None:
+          cs.none_accepted += o.accepted.empty() / n;
+          break;
+        case SweepCase::Kind::Outside:
+          cs.none_accepted += o.accepted.empty() / n;
+          cs.flagged += o.structure_flagged / n;
+          break;
+        case SweepCase::Kind::Pair: {
+          bool both = true;
+          for (const auto& h : cs.c.hidden)
+            both &= std::find(o.accepted.begin(), o.accepted.end(), h.name) != o.accepted.end();
+          cs.both_found += both / n;
+          cs.rmse_halved += halved / n;
+          break;
+        }
+      }
+    }
+  }
+  return out;
+}
+
+std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions& opt, double seconds) {
+  std::ostringstream md;
+  md << "Sweep: " << opt.seeds << " seeds per case, level " << opt.gen.level << ", drive patterns of "
+     << opt.gen.duration << " s, " << opt.diag.folds << "-fold split by run, acceptance dBIC > "
+     << opt.diag.bic_threshold << "; " << std::fixed << std::setprecision(0) << seconds << " s wall.\n\n";
+  md << "| hidden | truth | right first | params +-10 % | held-out RMS -50 % | ends <= 1.2x floor | nothing accepted | "
+        "structure flagged | both found | s/diagnose |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& c : s) {
+    std::ostringstream truth;
+    for (const auto& h : c.c.hidden)
+      for (const auto& [k, v] : h.params) truth << (truth.tellp() ? ", " : "") << h.name << "." << k << "=" << v;
+    if (c.c.tilt_deg != 0) truth << "floor tilt " << c.c.tilt_deg << " deg";
+    if (truth.str().empty()) truth << "-";
+    using K = SweepCase::Kind;
+    auto cell = [&](bool show, double v) { return show ? pct(v) : std::string("-"); };
+    md << "| " << c.c.name << " | " << truth.str() << " | " << cell(c.c.kind == K::Single, c.right_first) << " | "
+       << cell(c.c.kind == K::Single, c.params_within) << " | "
+       << cell(c.c.kind == K::Single || c.c.kind == K::Pair, c.rmse_halved) << " | " << pct(c.at_floor) << " | "
+       << cell(c.c.kind == K::None || c.c.kind == K::Outside, c.none_accepted) << " | "
+       << cell(c.c.kind == K::Outside, c.flagged) << " | " << cell(c.c.kind == K::Pair, c.both_found) << " | "
+       << std::setprecision(1) << c.mean_seconds << " |\n";
+  }
+  md << "\nPer seed (accepted effects, held-out normalised RMS before -> after, noise floor):\n\n";
+  for (const auto& c : s) {
+    md << "- **" << c.c.name << "**: ";
+    for (const auto& o : c.seeds) {
+      std::string acc;
+      for (const auto& a : o.accepted) acc += (acc.empty() ? "" : "+") + a;
+      md << "s" << o.seed << " {" << (acc.empty() ? "none" : acc) << "} " << std::setprecision(2) << o.rms_before
+         << "->" << o.rms_after << " (" << o.floor << ")" << (o.structure_flagged ? " F" : "") << "; ";
+    }
+    md << "\n";
+  }
+  return md.str();
+}
+
+int runSweepCommand(const std::multimap<std::string, std::string>& opts, const std::set<std::string>& flags) {
+  auto get = [&](const std::string& k, const std::string& def) {
+    auto it = opts.find(k);
+    return it == opts.end() ? def : it->second;
+  };
+  SweepOptions o;
+  o.gen.level = get("level", "simple");
+  o.gen.duration = std::stod(get("duration", "8"));
+  o.gen.measure_torque = flags.count("torque") != 0;
+  o.seeds = std::stoi(get("seeds", "10"));
+  o.first_seed = std::stoull(get("first-seed", "1"));
+  o.diag.folds = std::stoi(get("folds", "2"));
+  o.diag.bic_threshold = std::stod(get("threshold", "10"));
+  o.progress = !flags.count("quiet");
+  auto all = standardCases(o.gen.level);
+  if (opts.count("cases")) {
+    for (const auto& name : split(get("cases", ""), ',')) {
+      bool found = false;
+      for (const auto& c : all)
+        if (c.name == name) {
+          o.cases.push_back(c);
+          found = true;
+        }
+      if (!found) throw std::invalid_argument("unknown sweep case '" + name + "'");
+    }
+  } else {
+    o.cases = all;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto res = runSweep(o, WorkerPool::global());
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::string md = sweepMarkdown(res, o, secs);
+  std::printf("%s", md.c_str());
+  if (opts.count("out")) {
+    std::ofstream f(get("out", ""));
+    f << md;
+  }
+  return 0;
+}
+
+}  // namespace sbot::calib

@@ -1,0 +1,69 @@
+// The statistical evaluation of `diagnose` on synthetic data with known hidden effects: for every
+// case (one hidden effect, none, a floor tilt outside the library, two effects) and seed, generate a
+// dataset, diagnose it, and check the verdict against the truth. `sbot_calibrate sweep` prints the
+// full figures (docs/calibration.md); the test command runs a reduced set.
+#pragma once
+
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "calibration/diagnose.h"
+#include "calibration/generator.h"
+
+namespace sbot::calib {
+
+struct SweepCase {
+  std::string name;                  ///< "speed_scale", "none", "tilt2", "speed_scale+latency"
+  std::vector<EffectConfig> hidden;
+  double tilt_deg = 0;
+  enum class Kind { Single, None, Outside, Pair } kind = Kind::Single;
+  std::string level;                 ///< generator level override (empty: the sweep's)
+  std::set<std::string> families;    ///< experiment families override (empty: the sweep's)
+  bool torque = false;               ///< also measure track torques
+};
+
+struct SeedOutcome {
+  std::uint64_t seed = 0;
+  std::vector<std::string> accepted;
+  std::map<std::string, double> estimate, truth;  ///< "effect.param" -> value
+  double rms_before = 0, rms_after = 0, floor = 0;  ///< held-out normalised RMS; noise floor (truth model)
+  bool structure_flagged = false;
+  double seconds = 0;
+  std::string verdict;
+};
+
+struct CaseSummary {
+  SweepCase c;
+  std::vector<SeedOutcome> seeds;
+  // fractions over seeds
+  double right_first = 0;      ///< single: the hidden effect accepted first
+  double params_within = 0;    ///< single: its parameters within +-10 %
+  double rmse_halved = 0;      ///< single: held-out RMS fell by >= 50 %
+  double at_floor = 0;         ///< held-out RMS ends within 1.2x the noise floor
+  double none_accepted = 0;    ///< none / outside: nothing accepted
+  double flagged = 0;          ///< outside: residual structure flagged
+  double both_found = 0;       ///< pair: both effects accepted
+  double mean_seconds = 0;
+};
+
+/// The standard cases: every drive effect the generator's experiments can reveal, none, tilt, pairs.
+std::vector<SweepCase> standardCases(const std::string& level);
+
+struct SweepOptions {
+  std::vector<SweepCase> cases;
+  int seeds = 10;
+  std::uint64_t first_seed = 1;
+  GeneratorOptions gen;          ///< level, duration, families (hidden/seed/tilt set per case)
+  DiagnoseOptions diag;
+  bool progress = false;
+};
+
+std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool);
+std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions& opt, double seconds);
+
+/// `sbot_calibrate sweep` (options as parsed by the command line).
+int runSweepCommand(const std::multimap<std::string, std::string>& opts, const std::set<std::string>& flags);
+
+}  // namespace sbot::calib

@@ -1,0 +1,168 @@
+#include "two_sbots_trials.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "sbot_sim/core/actuators/gripper.h"
+#include "sbot_sim/core/robot_description.h"
+#include "sbot_sim/core/swarm/swarm_graph.h"
+#include "sbot_sim/core/world.h"
+
+namespace two_sbots {
+
+using namespace sbot;
+
+namespace {
+
+double tiltOf(const Robot& r) {
+  const Vec3 up = r.basePose().orientation * Vec3::UnitZ();
+  return std::acos(std::max(-1.0, std::min(1.0, up.z())));
+}
+
+}  // namespace
+
+SlopeResult pairSlope(const std::string& level, double angle, int trial, bool pair) {
+  WorldConfig c;
+  c.seed = 7000 + trial;
+  World w(c);
+  const double g = c.gravity;
+  dWorldSetGravity(w.odeWorld(), -g * std::sin(angle), 0, -g * std::cos(angle));
+  std::mt19937 rng(trial * 131 + static_cast<int>(angle * 1000));
+  std::uniform_real_distribution<double> u(-0.02, 0.02);
+  const RobotDescription& d = loadLevel(level);
+  // sbot_1 (holder) below, gripping sbot_0 above it (uphill = +x).
+  w.addRobot(d, {0, 0, u(rng)}, "sbot_1");
+  std::unique_ptr<actuators::FrontGripper> grip;
+  if (pair) {
+    w.addRobot(d, {0.3, 0, u(rng)}, "sbot_0");
+    swarm::createStaticLink(w, {"sbot_1", "sbot_0", swarm::kFrontGripper});
+    grip = std::make_unique<actuators::FrontGripper>(w, w.robot("sbot_1"));
+    grip->setElevation(0);
+  }
+  std::vector<Robot*> rs = w.robots();
+  for (Robot* r : rs) r->setSpeed(0, 0);
+  SlopeResult res{"full"};
+  bool toppled = false;
+  auto run = [&](double seconds) {
+    const int n = static_cast<int>(seconds / c.step);
+    for (int i = 0; i < n && !toppled; ++i) {
+      w.step();
+      if (grip) grip->update(c.step);
+      for (Robot* r : rs) {
+        res.max_tilt = std::max(res.max_tilt, tiltOf(*r));
+        if (tiltOf(*r) > 60 * M_PI / 180) toppled = true;
+      }
+    }
+  };
+  auto meanX = [&] {
+    double x = 0;
+    for (Robot* r : rs) x += r->basePose().position.x();
+    return x / rs.size();
+  };
+  run(0.2);
+  const double x0 = meanX();
+  run(3.0);
+  const double x1 = meanX();
+  res.slide = x0 - x1;
+  const double hold_tilt = res.max_tilt;
+  if (!toppled) {
+    for (Robot* r : rs) r->setSpeed(10, 10);
+    run(8.0);
+    res.efficiency = (meanX() - x1) / (10 * 0.0028 * 8.0);
+  }
+  if (toppled) res.label = "topple";
+  else if (res.slide > 0.01) res.label = "slide";
+  else if (res.efficiency < 0 ) res.label = "stable, slides back when driving";
+  else if (res.efficiency < 0.85 || res.max_tilt - hold_tilt > 8 * M_PI / 180) res.label = "difficult";
+  else res.label = "full";
+  return res;
+}
+
+// A step of `h` at x <= 0 (plateau toward -x); the robots face +x on the ground and reverse onto it.
+StepResult stepBackward(const std::string& level, double h, int trial, bool pair, bool verbose) {
+  WorldConfig c;
+  c.seed = 8000 + trial;
+  c.terrain.type = TerrainConfig::Type::Composite;
+  c.terrain.boxes.push_back({"step", Vec3(-1.0, 0, h / 2), Vec3(2.0, 1.0, h), 0, 0, "ground"});
+  World w(c);
+  std::mt19937 rng(trial * 977 + static_cast<int>(h * 1e4));
+  std::uniform_real_distribution<double> u(-1, 1);
+  const RobotDescription& d = loadLevel(level);
+  w.addRobot(d, {0.09 + 0.005 * u(rng), 0.005 * u(rng), 0.02 * u(rng)}, "sbot_1");
+  std::unique_ptr<actuators::FrontGripper> grip;
+  if (pair) {
+    w.addRobot(d, {0.4, 0, 0}, "sbot_0");
+    swarm::createStaticLink(w, {"sbot_1", "sbot_0", swarm::kFrontGripper});
+    grip = std::make_unique<actuators::FrontGripper>(w, w.robot("sbot_1"));
+    grip->setElevation(0);
+  }
+  Robot& a = w.robot("sbot_1");
+  Robot* b = pair ? &w.robot("sbot_0") : nullptr;
+  StepResult res{"fail"};
+  bool toppled = false;
+  const int speed = -15;
+  constexpr int kLiftElevation = -45;  // [deg] arm down: the holder pushes its own rear up
+  int phase = 0;
+  double phase_t = 0;
+  const double T = 40.0;
+  for (int i = 0; i < static_cast<int>(T / c.step); ++i) {
+    const double t = i * c.step;
+    const Pose pa = a.basePose();
+    if (pair) {
+      // Phase 0: reverse to the step. 1: arm down (lifts the holder's rear) while reversing.
+      // 2: holder's rear wheels on the step: arm back to level, keep reversing. 3: the held robot at
+      // the step: arm up (lifts it) and pull.
+      const Pose pb = b->basePose();
+      switch (phase) {
+        case 0:
+          if (pa.position.x() < 0.065 || t > 12) { phase = 1; phase_t = t; grip->setElevation(kLiftElevation); }
+          break;
+        case 1:
+          if (pa.position.z() > h + 0.012 || t - phase_t > 8) { phase = 2; phase_t = t; grip->setElevation(0); }
+          break;
+        case 2:
+          if (pb.position.x() < 0.075 || t - phase_t > 10) { phase = 3; phase_t = t; grip->setElevation(50); }
+          break;
+        case 3:
+          if (pb.position.z() > h + 0.012 && t - phase_t > 1.0) { phase = 4; grip->setElevation(0); }
+          break;
+        default: break;
+      }
+      // While the holder lifts itself the held robot stands (motors holding) as the arm's fulcrum.
+      a.setSpeed(speed, speed);
+      b->setSpeed(phase == 1 ? 0 : speed, phase == 1 ? 0 : speed);
+      if (verbose && i % 50 == 0)
+        std::printf("  t %.1f phase %d holder x %.3f z %.3f tilt %.0f | held x %.3f z %.3f tilt %.0f | elev %d\n", t,
+                    phase, pa.position.x(), pa.position.z(), tiltOf(a) * 180 / M_PI, pb.position.x(), pb.position.z(),
+                    tiltOf(*b) * 180 / M_PI, grip->getElevation());
+    } else {
+      a.setSpeed(speed, speed);
+    }
+    w.step();
+    if (grip) grip->update(c.step);
+    if (tiltOf(a) > 75 * M_PI / 180 || (b && tiltOf(*b) > 75 * M_PI / 180)) {
+      toppled = true;
+      break;
+    }
+    const bool a_up = a.basePose().position.x() < -0.10 && a.basePose().position.z() > h;
+    const bool b_up = !b || (b->basePose().position.x() < -0.10 && b->basePose().position.z() > h);
+    if (a_up && b_up) {
+      res.label = "pass";
+      break;
+    }
+  }
+  if (toppled) res.label = "topple";
+  res.x_holder = a.basePose().position.x();
+  res.z_holder = a.basePose().position.z();
+  if (b) {
+    res.x_held = b->basePose().position.x();
+    res.z_held = b->basePose().position.z();
+  }
+  return res;
+}
+
+}  // namespace two_sbots

@@ -1,0 +1,29 @@
+// Trials of the two-connected-s-bot validation rows (two_sbots tool, its gtest): seed Table 4.1
+// (two s-bots connected by the front gripper on a slope) and 4.1.3 (two-robot step passing going
+// backwards). See two_sbots.cpp.
+#pragma once
+
+#include <string>
+
+namespace two_sbots {
+
+struct SlopeResult {
+  std::string label;       ///< full, difficult, slide, topple, "stable, slides back when driving"
+  double slide = 0;        ///< [m] down the slope while standing 3 s
+  double efficiency = 0;   ///< climb progress / commanded over 8 s at 2.8 cm/s
+  double max_tilt = 0;     ///< [rad]
+};
+
+/// One s-bot (pair = false) or two connected by sbot_1's front gripper (sbot_0 uphill) on a slope of
+/// `angle` [rad] (tilted gravity): stand 3 s, climb 8 s.
+SlopeResult pairSlope(const std::string& level, double angle, int trial, bool pair);
+
+struct StepResult {
+  std::string label;  ///< pass, fail, topple
+  double x_holder = 0, z_holder = 0, x_held = 0, z_held = 0;
+};
+
+/// Reverse up a step `h` [m] high: one s-bot, or a pair whose holder lifts itself with its arm.
+StepResult stepBackward(const std::string& level, double h, int trial, bool pair, bool verbose);
+
+}  // namespace two_sbots

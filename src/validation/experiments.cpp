@@ -1,0 +1,485 @@
+#include "experiments.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <random>
+#include <sstream>
+
+#include "sbot_sim/core/robot_description.h"
+#include "sbot_sim/core/sensors/environment.h"
+#include "sbot_sim/core/sensors/sensor_suite.h"
+#include "sbot_sim/core/world.h"
+
+namespace sbot {
+namespace validation {
+namespace {
+
+constexpr double kSlowSpeed = 0.0028 * kSlowUnits;  // [m/s]
+
+/// Length scale of a level's world: the Fast model is the Simple one at half size (seed 3.1).
+double lengthScale(const std::string& level) { return level == "fast" ? 0.5 : 1.0; }
+
+WorldConfig configFor(const RobotDescription& d, std::uint64_t seed) {
+  WorldConfig c;
+  c.step = d.recommended_step;
+  c.gravity = d.gravity;
+  c.seed = seed;
+  // The level's recommended quickstep iterations (sidecar extra solver_iterations; Detailed: 40).
+  // At the world default (20) the 22-body Detailed model does not converge: it jitters at rest
+  // (~0.5 rad/s), sits nose-down and topples off steps it climbs cleanly at 40 and above.
+  const int iterations = std::atoi(d.extraOr("solver_iterations", "0").c_str());
+  if (iterations > 0) c.solver_iterations = iterations;
+  if (const char* e = std::getenv("SBOT_VALIDATE_ITERATIONS")) c.solver_iterations = std::atoi(e);  // override (study)
+  return c;
+}
+
+/// Per-trial generator of the start perturbations.
+struct Jitter {
+  std::mt19937_64 gen;
+  Jitter(const std::string& what, double param, int trial)
+      : gen(std::hash<std::string>()(what) ^ (static_cast<std::uint64_t>(std::lround(param * 1e6)) * 1000003ULL) ^
+            (static_cast<std::uint64_t>(trial) * 0x9E3779B97F4A7C15ULL)) {}
+  double uniform(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(gen); }
+};
+
+Vec3 upOf(const Robot& r) { return r.basePose().orientation * Vec3::UnitZ(); }
+double angleBetween(const Vec3& a, const Vec3& b) {
+  return std::acos(std::max(-1.0, std::min(1.0, a.normalized().dot(b.normalized()))));
+}
+double headingOf(const Robot& r) {
+  const Vec3 f = r.basePose().orientation * Vec3::UnitX();
+  return std::atan2(f.y(), f.x());
+}
+
+/// Run `seconds` of simulated time, calling `check` every 0.05 s; stops early when it returns true.
+template <typename F>
+void runFor(World& w, double seconds, F check) {
+  const int every = std::max(1, static_cast<int>(std::lround(0.05 / w.config().step)));
+  const int steps = static_cast<int>(std::ceil(seconds / w.config().step));
+  for (int s = 0; s < steps; ++s) {
+    w.step();
+    if ((s + 1) % every == 0 && check()) return;
+  }
+}
+
+/// A box whose top face is a ramp of `angle` (rising along +x for angle > 0, falling for < 0)
+/// starting at `foot` (the top face's edge at x = foot.x, height foot.z), `length` along the slope.
+BoxObstacle ramp(const Vec3& foot, double angle, double length, const std::string& name) {
+  const double t = 0.05;
+  BoxObstacle b;
+  b.name = name;
+  b.size = Vec3(length, 1.0, t);
+  b.pitch = -angle;  // pitch about +y turns +x toward -z: a rising ramp has negative pitch
+  // Rotation about y by phi = -angle maps the local point (-L/2, 0, t/2) (the top face's start edge).
+  const double phi = b.pitch;
+  const Vec3 local(-length / 2, 0, t / 2);
+  const Vec3 rotated(std::cos(phi) * local.x() + std::sin(phi) * local.z(), 0,
+                     -std::sin(phi) * local.x() + std::cos(phi) * local.z());
+  b.center = foot - rotated;
+  return b;
+}
+
+BoxObstacle block(double x0, double x1, double top, const std::string& name) {
+  BoxObstacle b;
+  b.name = name;
+  b.center = Vec3((x0 + x1) / 2, 0, top / 2);
+  b.size = Vec3(x1 - x0, 1.0, top);
+  return b;
+}
+
+/// The front gripper's servos (elevation, jaws) are powered on the real robot and hold their
+/// position; without the gripper module the core leaves them passive and the gripper would hang on
+/// its stop and prop the robot up. Hold every servo joint that is neither a track, the turret nor
+/// the side arm (the core holds that) with its own torque at the spawn position (elevation 0).
+void holdServos(Robot& r) {
+  const RobotDescription& d = r.description();
+  for (const auto& j : d.joints) {
+    if (j.type == JointDescription::Type::Fixed || j.effort <= 0) continue;
+    if (j.name == d.turret.joint || j.name.rfind("side_arm", 0) == 0) continue;
+    const auto& L = d.treels.left_joints;
+    const auto& R = d.treels.right_joints;
+    if (std::find(L.begin(), L.end(), j.name) != L.end() || std::find(R.begin(), R.end(), j.name) != R.end()) continue;
+    dJointID h = r.hingeJoint(j.name);
+    if (!h) continue;
+    dJointSetHingeParam(h, dParamVel, 0);
+    dJointSetHingeParam(h, dParamFMax, j.effort);
+  }
+}
+
+Robot& spawn(World& w, const RobotDescription& d, const Pose2D& p) {
+  Robot& r = w.addRobot(d, p, "sbot");
+  holdServos(r);
+  return r;
+}
+
+}  // namespace
+
+// ---- Table 4.2 / 4.5: gap ------------------------------------------------------------------------
+
+Outcome gapTrial(const std::string& level, double gap_m, int trial) {
+  const RobotDescription& d = loadLevel(level);
+  const double s = lengthScale(level);
+  Jitter j("gap" + level, gap_m, trial);
+  WorldConfig c = configFor(d, 1000 + trial);
+  const double top = 0.10;
+  c.terrain.type = TerrainConfig::Type::Composite;
+  c.terrain.boxes.push_back(block(-1.0 - gap_m / 2, -gap_m / 2, top, "near_side"));
+  c.terrain.boxes.push_back(block(gap_m / 2, 1.0 + gap_m / 2, top, "far_side"));
+  World w(c);
+  const double x0 = -gap_m / 2 - 0.075 * s + j.uniform(-0.005, 0.005) * s;
+  Robot& r = spawn(w, d, {x0, j.uniform(-0.01, 0.01) * s, j.uniform(-0.05, 0.05)});
+  r.setSpeed(0, 0);
+  w.stepN(static_cast<int>(0.3 / c.step));
+  const double z0 = r.basePose().position.z();
+  r.setSpeed(kSlowUnits, kSlowUnits);
+  Outcome o{"stuck"};
+  const double goal = gap_m / 2 + 0.09 * s;
+  runFor(w, (gap_m + 0.30 * s) / kSlowSpeed + 4.0, [&] {
+    const Vec3 p = r.basePose().position;
+    if (angleBetween(upOf(r), Vec3::UnitZ()) > 80 * M_PI / 180) { o.label = "topple"; return true; }
+    if (p.x() > goal && p.z() > z0 - 0.01 * s) { o.label = "pass"; return true; }
+    return false;
+  });
+  o.value = r.basePose().position.x();
+  o.value2 = z0 - r.basePose().position.z();
+  return o;
+}
+
+// ---- Table 4.3: step ------------------------------------------------------------------------------
+
+Outcome stepTrial(const std::string& level, double height_m, bool backward, int trial) {
+  const RobotDescription& d = loadLevel(level);
+  const double s = lengthScale(level);
+  Jitter j(std::string("step") + (backward ? "b" : "f") + level, height_m, trial);
+  WorldConfig c = configFor(d, 2000 + trial);
+  c.terrain.type = TerrainConfig::Type::Composite;
+  c.terrain.boxes.push_back(block(0.0, 1.0, height_m, "step"));
+  World w(c);
+  const double x0 = -0.075 * s + j.uniform(-0.005, 0.005) * s;
+  const double yaw = (backward ? M_PI : 0.0) + j.uniform(-0.03, 0.03);
+  Robot& r = spawn(w, d, {x0, j.uniform(-0.01, 0.01) * s, yaw});
+  r.setSpeed(0, 0);
+  w.stepN(static_cast<int>(0.3 / c.step));
+  const double z0 = r.basePose().position.z();
+  const int u = backward ? -kSlowUnits : kSlowUnits;
+  r.setSpeed(u, u);
+  Outcome o{"fail"};
+  runFor(w, 0.25 * s / kSlowSpeed + 8.0, [&] {
+    const Vec3 p = r.basePose().position;
+    if (angleBetween(upOf(r), Vec3::UnitZ()) > 80 * M_PI / 180) { o.label = "topple"; return true; }
+    if (p.x() > 0.09 * s && p.z() > z0 + height_m - 0.006) { o.label = "pass"; return true; }
+    return false;
+  });
+  o.value = r.basePose().position.x();
+  o.value2 = r.basePose().position.z() - z0;
+  return o;
+}
+
+// ---- Table 4.1: slope, hold then climb ------------------------------------------------------------
+
+Outcome slopeHoldClimbTrial(const std::string& level, double angle_rad, bool backward, int trial) {
+  const RobotDescription& d = loadLevel(level);
+  Jitter j(std::string("slope") + (backward ? "b" : "f") + level, angle_rad, trial);
+  WorldConfig c = configFor(d, 3000 + trial);
+  World w(c);
+  // A tilted gravity is an infinite slope rising toward +x.
+  const double g = c.gravity;
+  dWorldSetGravity(w.odeWorld(), -g * std::sin(angle_rad), 0, -g * std::cos(angle_rad));
+  const double yaw = (backward ? M_PI : 0.0) + j.uniform(-0.03, 0.03);
+  Robot& r = spawn(w, d, {0, 0, yaw});
+  r.setSpeed(0, 0);
+  Outcome o{"full"};
+  double max_tilt = 0;
+  bool toppled = false;
+  auto watch = [&] {
+    const double tilt = angleBetween(upOf(r), Vec3::UnitZ());  // relative to the slope's normal
+    max_tilt = std::max(max_tilt, tilt);
+    if (tilt > 60 * M_PI / 180) { toppled = true; return true; }
+    return false;
+  };
+  const double x_start = r.basePose().position.x();
+  runFor(w, 3.0, watch);
+  const double x_hold = r.basePose().position.x();
+  const double slide = x_start - x_hold;
+  const double hold_tilt = max_tilt;
+  double progress = 0;
+  if (!toppled) {
+    const int u = backward ? -kSlowUnits : kSlowUnits;
+    r.setSpeed(u, u);
+    const double t_climb = 8.0;
+    runFor(w, t_climb, watch);
+    progress = r.basePose().position.x() - x_hold;
+    o.value = progress / (kSlowSpeed * t_climb);
+  }
+  o.value2 = max_tilt;
+  if (toppled) o.label = "topple b/w";
+  else if (slide > 0.01 || progress < 0) o.label = "slide";
+  else if (o.value < 0.85 || max_tilt - hold_tilt > 8 * M_PI / 180) o.label = "difficult";
+  else o.label = "full";
+  return o;
+}
+
+// ---- Table 4.6: uphill ramp from flat ground -----------------------------------------------------
+
+Outcome uphillTrial(const std::string& level, double angle_rad, int trial) {
+  const RobotDescription& d = loadLevel(level);
+  const double s = lengthScale(level);
+  Jitter j("uphill" + level, angle_rad, trial);
+  WorldConfig c = configFor(d, 4000 + trial);
+  c.terrain.type = TerrainConfig::Type::Composite;
+  c.terrain.boxes.push_back(ramp(Vec3(0, 0, 0), angle_rad, 0.6 * s, "ramp"));
+  World w(c);
+  const double yaw0 = j.uniform(-0.05, 0.05);
+  Robot& r = spawn(w, d, {-0.12 * s + j.uniform(-0.01, 0.01) * s, j.uniform(-0.01, 0.01) * s, yaw0});
+  r.setSpeed(0, 0);
+  w.stepN(static_cast<int>(0.3 / c.step));
+  const double h0 = headingOf(r);
+  const double z0 = r.basePose().position.z();
+  r.setSpeed(kSlowUnits, kSlowUnits);
+  const Vec3 normal(-std::sin(angle_rad), 0, std::cos(angle_rad));
+  double best = 0;
+  Outcome o{"stuck"};
+  auto along = [&] {  // progress up the slope [m], 0 before the foot
+    const Vec3 p = r.basePose().position;
+    return p.x() > 0 ? std::hypot(p.x(), std::max(0.0, p.z() - z0)) : 0.0;
+  };
+  runFor(w, (0.12 * s + 0.30 * s) / kSlowSpeed * 1.3 + 4.0, [&] {
+    const Vec3 up = upOf(r);
+    if (angleBetween(up, Vec3::UnitZ()) > 100 * M_PI / 180 ||
+        (r.basePose().position.x() > 0 && angleBetween(up, normal) > 75 * M_PI / 180)) {
+      o.label = "topple";
+      return true;
+    }
+    best = std::max(best, along());
+    if (along() > 0.25 * s) { o.label = "climb"; return true; }
+    return false;
+  });
+  const double dh = std::fabs(std::remainder(headingOf(r) - h0, 2 * M_PI));
+  o.value = best;
+  o.value2 = dh;
+  if (o.label == "stuck") {
+    if (best > 0.03 * s && along() < best - 0.03 * s) o.label = "slide back";
+    else if (best > 0.05 * s) o.label = "slipping";
+    else if (dh > 0.35) o.label = "c/c";
+  }
+  return o;
+}
+
+Outcome downhillTrial(const std::string& level, double angle_rad, int trial) {
+  const RobotDescription& d = loadLevel(level);
+  const double s = lengthScale(level);
+  Jitter j("downhill" + level, angle_rad, trial);
+  WorldConfig c = configFor(d, 5000 + trial);
+  c.terrain.type = TerrainConfig::Type::Composite;
+  const double L = 0.4 * s;
+  const double H = L * std::sin(angle_rad);
+  c.terrain.boxes.push_back(block(-1.0, 0.0, H, "plateau"));
+  c.terrain.boxes.push_back(ramp(Vec3(0, 0, H), -angle_rad, L + 0.05, "ramp"));
+  World w(c);
+  Robot& r = spawn(w, d, {-0.10 * s + j.uniform(-0.01, 0.01) * s, j.uniform(-0.01, 0.01) * s, j.uniform(-0.05, 0.05)});
+  r.setSpeed(0, 0);
+  w.stepN(static_cast<int>(0.3 / c.step));
+  r.setSpeed(kSlowUnits, kSlowUnits);
+  Outcome o{"stuck"};
+  const double goal = L * std::cos(angle_rad) + 0.10 * s;
+  runFor(w, (0.10 * s + L + 0.1 * s) / kSlowSpeed * 1.3 + 4.0, [&] {
+    if (angleBetween(upOf(r), Vec3::UnitZ()) > 100 * M_PI / 180) { o.label = "topple"; return true; }
+    if (r.basePose().position.x() > goal && angleBetween(upOf(r), Vec3::UnitZ()) < 0.3) { o.label = "pass"; return true; }
+    return false;
+  });
+  o.value = r.basePose().position.x();
+  return o;
+}
+
+// ---- Figure 4.4: rough terrain ------------------------------------------------------------------
+
+Outcome roughTrial(const std::string& level, double hr_mm, int trial, const std::string& heightmap_png) {
+  const RobotDescription& d = loadLevel(level);
+  const double s = lengthScale(level);
+  Jitter j("rough" + level, hr_mm, trial);
+  WorldConfig c = configFor(d, 6000 + trial);
+  c.terrain.type = TerrainConfig::Type::Rough;
+  c.terrain.heightmap_image = heightmap_png;
+  c.terrain.heightmap_seed = 7;
+  c.terrain.size_x = c.terrain.size_y = 5.0 * s;  // 4.2.2: the Fast model's terrain is halved
+  c.terrain.height_range = hr_mm / 1000.0 * s;
+  World w(c);
+  Robot& r = spawn(w, d, {j.uniform(-1.5, 1.5) * s, j.uniform(-1.5, 1.5) * s, j.uniform(-M_PI, M_PI)});
+  r.setSpeed(0, 0);
+  w.stepN(static_cast<int>(1.0 / c.step));
+  const Vec3 p0 = r.basePose().position;
+  const double h0 = headingOf(r);
+  r.setTrackSpeeds(0.1524, 0.1524);  // 4.2.2: "medium speed (15.24 cm/s)"
+  w.stepN(static_cast<int>(std::lround(10.0 / c.step)));
+  const Vec3 p1 = r.basePose().position;
+  Outcome o{"ok"};
+  o.value = (p1 - p0).dot(Vec3(std::cos(h0), std::sin(h0), 0));
+  o.value2 = std::fabs(std::remainder(headingOf(r) - h0, 2 * M_PI));
+  return o;
+}
+
+// ---- Table 4.4: efficiency ------------------------------------------------------------------------
+
+Outcome rtmTrial(const std::string& level, double sim_seconds, bool with_sensors) {
+  const RobotDescription& d = loadLevel(level);
+  WorldConfig c = configFor(d, 7);
+  World w(c);
+  Robot& r = spawn(w, d, {0, 0, 0});
+  sensors::Environment env(w);
+  sensors::SensorSuite suite(w, r, env);
+  const bool ground = suite.available(sensors::SensorChannel::Ground);
+  const bool light = suite.available(sensors::SensorChannel::Light);
+  const int steps = static_cast<int>(sim_seconds / c.step);
+  const int change_every = std::max(1, static_cast<int>(1.0 / c.step));
+  unsigned sink = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < steps; ++i) {
+    if (i % change_every == 0) {
+      r.setSpeed(static_cast<int>(r.random().uniform("walk", -70, 70)),
+                 static_cast<int>(r.random().uniform("walk", -70, 70)));
+    }
+    w.step();
+    if (!with_sensors) continue;
+    suite.update(c.step);
+    // The seed's controllers read the proximity ring every step; ground and light where present.
+    for (unsigned v : suite.getAllProximitySensors()) sink += v;
+    if (ground) for (unsigned v : suite.getAllGroundSensors()) sink += v;
+    if (light) for (unsigned v : suite.getAllLightSensors()) sink += v;
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  Outcome o{sink == 0xFFFFFFFFu ? "ok!" : "ok"};
+  o.value = w.time() / wall;
+  o.value2 = 1000.0 * wall / steps;
+  return o;
+}
+
+Outcome steadySpeedTrial(const std::string& level, int units) {
+  const RobotDescription& d = loadLevel(level);
+  WorldConfig c = configFor(d, 8);
+  World w(c);
+  Robot& r = spawn(w, d, {0, 0, 0});
+  r.setSpeed(units, units);
+  w.stepN(static_cast<int>(3.0 / c.step));
+  const Vec3 a = r.basePose().position;
+  w.stepN(static_cast<int>(3.0 / c.step));
+  const Vec3 b = r.basePose().position;
+  Outcome o{"ok"};
+  o.value = (b - a).head<2>().norm() / 3.0;
+  return o;
+}
+
+// ---- infrastructure -------------------------------------------------------------------------------
+
+std::vector<Outcome> runParallel(int n, int processes, const std::function<Outcome(int)>& fn) {
+  std::vector<Outcome> out(n, Outcome{"error"});
+  if (n <= 0) return out;
+  processes = std::max(1, std::min(processes, n));
+  std::vector<std::string> files;
+  std::vector<pid_t> pids;
+  std::fflush(stdout);
+  std::fflush(stderr);
+  for (int k = 0; k < processes; ++k) {
+    char tmpl[] = "/tmp/sbot_validate_XXXXXX";
+    const int fd = mkstemp(tmpl);
+    if (fd < 0) continue;
+    close(fd);
+    files.push_back(tmpl);
+    const pid_t pid = fork();
+    if (pid == 0) {
+      std::ofstream f(files.back());
+      for (int i = k; i < n; i += processes) {
+        Outcome o{"error"};
+        try {
+          o = fn(i);
+        } catch (const std::exception& e) {
+          std::fprintf(stderr, "sbot_validate: job %d: %s\n", i, e.what());
+        }
+        std::string label = o.label;
+        std::replace(label.begin(), label.end(), '\t', ' ');
+        f << i << '\t' << label << '\t' << o.value << '\t' << o.value2 << '\n';
+        f.flush();
+      }
+      f.close();
+      std::_Exit(0);
+    }
+    pids.push_back(pid);
+  }
+  for (pid_t p : pids) {
+    int status = 0;
+    waitpid(p, &status, 0);
+  }
+  for (const auto& name : files) {
+    std::ifstream f(name);
+    std::string line;
+    while (std::getline(f, line)) {
+      std::stringstream ss(line);
+      std::string idx, label, v1, v2;
+      std::getline(ss, idx, '\t');
+      std::getline(ss, label, '\t');
+      std::getline(ss, v1, '\t');
+      std::getline(ss, v2, '\t');
+      const int i = std::atoi(idx.c_str());
+      if (i >= 0 && i < n) out[i] = Outcome{label, std::atof(v1.c_str()), std::atof(v2.c_str())};
+    }
+    std::remove(name.c_str());
+  }
+  return out;
+}
+
+std::string modal(const std::vector<Outcome>& outcomes, int* count) {
+  std::map<std::string, int> counts;
+  std::string best;
+  int best_n = 0;
+  for (const auto& o : outcomes) {
+    const int c = ++counts[o.label];
+    if (c > best_n) { best_n = c; best = o.label; }
+  }
+  if (count) *count = best_n;
+  return best;
+}
+
+}  // namespace validation
+}  // namespace sbot
+
+namespace sbot {
+namespace validation {
+
+std::string restFacts(const std::string& level) {
+  const RobotDescription& d = loadLevel(level);
+  WorldConfig c = configFor(d, 9);
+  World w(c);
+  Robot& r = spawn(w, d, {0, 0, 0});
+  r.setSpeed(0, 0);
+  w.stepN(static_cast<int>(2.0 / c.step));
+  // Whole-robot centre of mass in the base frame.
+  double m = 0;
+  Vec3 com = Vec3::Zero();
+  for (dBodyID b : r.bodies()) {
+    dMass mass;
+    dBodyGetMass(b, &mass);
+    const dReal* p = dBodyGetPosition(b);
+    com += mass.mass * Vec3(p[0], p[1], p[2]);
+    m += mass.mass;
+  }
+  com /= m;
+  const Pose base = r.basePose();
+  const Vec3 com_b = base.inverse().transform(com);
+  const Vec3 rpy = rpyFromQuat(base.orientation);
+  std::ostringstream s;
+  s << level << ": mass " << m << " kg, bodies " << r.bodies().size() << ", COM in base frame (" << com_b.x() << ", "
+    << com_b.y() << ", " << com_b.z() << ") m, COM height above ground " << com.z() << " m, base height "
+    << base.position.z() << " m, rest roll " << rpy.x() * 180 / M_PI << " deg pitch " << rpy.y() * 180 / M_PI
+    << " deg";
+  return s.str();
+}
+
+}  // namespace validation
+}  // namespace sbot

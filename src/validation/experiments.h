@@ -1,0 +1,70 @@
+// Validation experiments of the seed's chapter 4 (Tables 4.1-4.6, Figure 4.4), run headless on the
+// ROS-free core. Each function builds a fresh World, runs one trial and classifies its outcome with
+// the seed's vocabulary. Used by sbot_validate (full report) and by the decisive-cell gtest.
+//
+// Trials are independent and deterministic in (level, parameter, trial index): the small random
+// start perturbations (lateral offset, heading, distance to the obstacle) come from the trial seed.
+// Run trials in separate processes (runParallel), never in threads: ODE's quickstep generator is
+// global.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace sbot {
+namespace validation {
+
+struct Outcome {
+  std::string label;        ///< the seed's word: pass, stuck, climb, topple, full, ...
+  double value = 0;         ///< experiment-specific measurement (progress [m], distance [m], ...)
+  double value2 = 0;        ///< second measurement (heading change [rad], slide [m], ...)
+};
+
+/// Speed used by the seed for gap and slope experiments (4.2.3, 4.2.4): 2.8 cm/s = 10 API units.
+constexpr int kSlowUnits = 10;
+
+/// Table 4.2 / 4.5: drive at 2.8 cm/s across a gap `gap_m` wide between two 10 cm high platforms.
+/// Labels: pass, stuck (fell inside or stuck at the edge), topple.
+Outcome gapTrial(const std::string& level, double gap_m, int trial);
+
+/// Table 4.3: drive into a step `height_m` high, forward (backward = false) or backward.
+/// Labels: pass, fail, topple.
+Outcome stepTrial(const std::string& level, double height_m, bool backward, int trial);
+
+/// Table 4.1: placed on a slope `angle_rad` (gravity tilted), first stand still 3 s with the motors
+/// holding, then climb 8 s at 2.8 cm/s. `backward`: the robot faces downhill and climbs in reverse.
+/// Labels: full, difficult, slide, topple b/w. value = climb efficiency (progress / commanded).
+Outcome slopeHoldClimbTrial(const std::string& level, double angle_rad, bool backward, int trial);
+
+/// Table 4.6: drive from flat ground at 2.8 cm/s into an uphill ramp of `angle_rad`.
+/// Labels: climb, c/c, stuck, slipping, slide back, topple.
+Outcome uphillTrial(const std::string& level, double angle_rad, int trial);
+
+/// 4.2.4 downhill: drive from a plateau down a ramp of `angle_rad`. Labels: pass, topple, stuck.
+Outcome downhillTrial(const std::string& level, double angle_rad, int trial);
+
+/// Figure 4.4: random pose and heading on rough terrain of height range `hr_mm`, 10 s at
+/// 15.24 cm/s; value = travelled distance projected on the initial heading [m].
+Outcome roughTrial(const std::string& level, double hr_mm, int trial, const std::string& heightmap_png);
+
+/// Table 4.4: real-time multiplier of one s-bot on flat ground with its level's sensors read every
+/// step, over `sim_seconds`. value = RTM, value2 = wall ms per step.
+Outcome rtmTrial(const std::string& level, double sim_seconds, bool with_sensors = true);
+
+/// Seed 2.1.3: steady speed [m/s] at setSpeed(units, units) on flat ground (value).
+Outcome steadySpeedTrial(const std::string& level, int units);
+
+/// Mass, bodies, centre of mass (base frame and height) and rest attitude on flat ground after 2 s.
+std::string restFacts(const std::string& level);
+
+/// Run `n` jobs in `processes` forked workers; job i returns fn(i). Results in job order. A job
+/// that crashes or throws yields label "error".
+std::vector<Outcome> runParallel(int n, int processes, const std::function<Outcome(int)>& fn);
+
+/// The modal label of a set of outcomes (ties: the first label reaching the count, in input order).
+std::string modal(const std::vector<Outcome>& outcomes, int* count = nullptr);
+
+}  // namespace validation
+}  // namespace sbot

@@ -1,0 +1,133 @@
+#!/usr/bin/python3
+"""The rosbag importer: a generated dataset is written as a bag (simulator topics and message types,
+an overhead tracker as geometry_msgs/PoseStamped), imported back with bag_to_dataset.py and loaded by
+sbot_calibrate; commands and measurements must survive the trip. Usage: test_bag_importer.py SBOT_CALIBRATE
+"""
+import csv
+import math
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import genpy
+import genpy.dynamic
+import rosbag
+import rospy
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(ROOT, "src", "calibration"))
+import bag_to_dataset  # noqa: E402
+
+SEP = "\n" + "=" * 80 + "\n"
+HEADER = "MSG: std_msgs/Header\nuint32 seq\ntime stamp\nstring frame_id\n"
+
+
+def msg_class(name, text, deps=""):
+    return genpy.dynamic.generate_dynamic(name, text + deps)[name]
+
+
+def sbot_msg(name):
+    with open(os.path.join(ROOT, "sbot_msgs", "msg", name + ".msg")) as f:
+        text = f.read()
+    return msg_class("sbot_msgs/" + name, text, SEP + HEADER if "Header" in text else "")
+
+
+PoseStamped = msg_class(
+    "geometry_msgs/PoseStamped", "std_msgs/Header header\ngeometry_msgs/Pose pose\n",
+    SEP + HEADER + SEP + "MSG: geometry_msgs/Pose\ngeometry_msgs/Point position\ngeometry_msgs/Quaternion orientation\n"
+    + SEP + "MSG: geometry_msgs/Point\nfloat64 x\nfloat64 y\nfloat64 z\n"
+    + SEP + "MSG: geometry_msgs/Quaternion\nfloat64 x\nfloat64 y\nfloat64 z\nfloat64 w\n")
+TrackSpeed = sbot_msg("TrackSpeed")
+TrackState = sbot_msg("TrackState")
+Slope = sbot_msg("Slope")
+
+
+def read_csv(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+class BagImporterTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tool = sys.argv[1] if len(sys.argv) > 1 else "sbot_calibrate"
+        cls.tmp = tempfile.mkdtemp(prefix="sbot_bag_importer_")
+        subprocess.check_call([cls.tool, "generate", "--out", os.path.join(cls.tmp, "src"), "--seed", "4",
+                               "--duration", "3", "--families", "straight,spin", "--torque", "--jobs", "1"],
+                              stdout=subprocess.DEVNULL)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def write_bag(self, run, path, with_commands=True):
+        rows = read_csv(os.path.join(self.tmp, "src", run + ".csv"))
+        base = 1000.0
+        with rosbag.Bag(path, "w") as bag:
+            for r in rows:
+                t = rospy.Time.from_sec(base + float(r["t"]))
+                if r["cmd_left"] != "" and with_commands:
+                    bag.write("/sbot_0/cmd_speed", TrackSpeed(left=int(float(r["cmd_left"])),
+                                                               right=int(float(r["cmd_right"]))), t)
+                if r["x"] != "":
+                    m = PoseStamped()
+                    m.header.stamp = t
+                    m.pose.position.x, m.pose.position.y = float(r["x"]), float(r["y"])
+                    yaw = float(r["yaw"])
+                    m.pose.orientation.z, m.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+                    bag.write("/tracker/sbot_0", m, t)
+                if r["speed_left"] != "":
+                    m = TrackState()
+                    m.header.stamp = t
+                    m.measured_left, m.measured_right = int(float(r["speed_left"])), int(float(r["speed_right"]))
+                    m.torque_left, m.torque_right = int(float(r["torque_left"])), int(float(r["torque_right"]))
+                    bag.write("/sbot_0/track_state", m, t)
+                if r["pitch"] != "":
+                    m = Slope()
+                    m.header.stamp = t
+                    m.pitch, m.roll = int(round(math.degrees(float(r["pitch"])))), int(round(math.degrees(float(r["roll"]))))
+                    bag.write("/sbot_0/slope", m, t)
+        return rows
+
+    def test_round_trip(self):
+        bags = []
+        originals = {}
+        for run in ("straight_40", "spin_cw_30"):
+            path = os.path.join(self.tmp, run + ".bag")
+            originals[run] = self.write_bag(run, path)
+            bags.append(path)
+        out = os.path.join(self.tmp, "imported")
+        self.assertEqual(bag_to_dataset.main([out] + bags + ["--tracker-topic", "/tracker/sbot_0", "--level", "simple"]), 0)
+        for run, rows in originals.items():
+            imported = read_csv(os.path.join(out, run + ".csv"))
+            orig_pose = [(float(r["t"]), float(r["x"]), float(r["yaw"])) for r in rows if r["x"] != ""]
+            imp_pose = [(float(r["t"]), float(r["x"]), float(r["yaw"])) for r in imported if r["x"] != ""]
+            self.assertEqual(len(orig_pose), len(imp_pose), run)
+            for (ta, xa, ya), (tb, xb, yb) in zip(orig_pose, imp_pose):
+                self.assertAlmostEqual(ta, tb, places=5)  # both relative to the first message (a command at 0)
+                self.assertAlmostEqual(xa, xb, places=7)
+                self.assertAlmostEqual(math.remainder(ya - yb, 2 * math.pi), 0.0, places=7)
+            cmds_a = [(r["cmd_left"], r["cmd_right"]) for r in rows if r["cmd_left"] != ""]
+            cmds_b = [(r["cmd_left"], r["cmd_right"]) for r in imported if r["cmd_left"] != ""]
+            self.assertEqual([tuple(float(v) for v in c) for c in cmds_a], [tuple(float(v) for v in c) for c in cmds_b])
+            self.assertIn("torque_left", imported[0])
+        # The C++ tool loads and replays the imported dataset.
+        res = subprocess.run([self.tool, "compare", out, "--no-plots", "--out", os.path.join(self.tmp, "report"),
+                              "--jobs", "1"], capture_output=True, text=True)
+        self.assertEqual(res.returncode, 0, res.stderr)
+        self.assertIn("nominal", res.stdout)
+
+    def test_bag_without_commands_is_refused(self):
+        path = os.path.join(self.tmp, "nocmd.bag")
+        self.write_bag("straight_20", path, with_commands=False)
+        with self.assertRaises(SystemExit) as e:
+            bag_to_dataset.main([os.path.join(self.tmp, "bad"), path, "--tracker-topic", "/tracker/sbot_0"])
+        self.assertIn("command", str(e.exception))
+
+
+if __name__ == "__main__":
+    unittest.main(argv=sys.argv[:1])

@@ -1,0 +1,181 @@
+// Dataset format sbot-dataset/1: round trip, held commands, and bad datasets reported with file,
+// line and column.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "calibration/dataset.h"
+
+namespace sbot::calib {
+namespace {
+
+std::string tempDir(const std::string& name) {
+  const std::string d = testing::TempDir() + "sbot_dataset_" + name;
+  ::mkdir(d.c_str(), 0755);
+  return d;
+}
+
+void write(const std::string& path, const std::string& text) {
+  std::ofstream f(path);
+  f << text;
+}
+
+const char* kYaml =
+    "format: sbot-dataset/1\n"
+    "name: test\n"
+    "robot: simple\n"
+    "world:\n"
+    "  obstacles:\n"
+    "    - {name: wall, center: [0.5, 0, 0.05], size: [0.02, 1, 0.1], yaw: 0, surface: white_paper}\n"
+    "runs:\n"
+    "  - {name: straight, file: straight.csv, kind: drive, initial_pose: {x: 0, y: 0, yaw: 0}}\n";
+
+/// A dataset directory with kYaml (optionally edited) and one run file.
+std::string makeDataset(const std::string& name, const std::string& csv, const std::string& yaml = kYaml) {
+  const std::string d = tempDir(name);
+  write(d + "/dataset.yaml", yaml);
+  write(d + "/straight.csv", csv);
+  return d;
+}
+
+DatasetError errorOf(const std::string& dir) {
+  try {
+    loadDataset(dir);
+  } catch (const DatasetError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no error for " << dir;
+  return DatasetError("", 0, 0, "", "");
+}
+
+TEST(Dataset, LoadsChannelsWithDifferentRatesAndHeldCommands) {
+  const std::string d = makeDataset("ok",
+                                    "t,cmd_left,cmd_right,x,y,yaw,speed_left\n"
+                                    "0,20,20,0,0,0,\n"
+                                    "0.05,,,0.001,0,0.01,20\n"
+                                    "0.1,40,-40,,,,\n"
+                                    "0.15,,,0.003,0.001,0.02,39\n");
+  const Dataset ds = loadDataset(d);
+  ASSERT_EQ(ds.runs.size(), 1u);
+  const calib::Run& r = ds.runs[0];
+  EXPECT_EQ(ds.robot, "simple");
+  EXPECT_EQ(r.channels.at("x").v.size(), 3u);
+  EXPECT_EQ(r.channels.at("speed_left").v.size(), 2u);
+  EXPECT_DOUBLE_EQ(r.channels.at("speed_left").t[1], 0.15);
+  EXPECT_EQ(r.commandAt(0.07), std::make_pair(20.0, 20.0));
+  EXPECT_EQ(r.commandAt(0.12), std::make_pair(40.0, -40.0));
+  EXPECT_EQ(r.commandAt(-1), std::make_pair(0.0, 0.0));
+  ASSERT_EQ(ds.world.terrain.boxes.size(), 1u);
+  EXPECT_EQ(ds.world.terrain.boxes[0].surface, "white_paper");
+  EXPECT_EQ(r.group, "straight");
+}
+
+TEST(Dataset, WriteThenLoadRoundTrips) {
+  Dataset ds;
+  ds.name = "rt";
+  ds.robot = "medium";
+  calib::Run drive;
+  drive.name = "arc_1";
+  drive.kind = RunKind::Drive;
+  drive.initial_pose = {0.1, -0.2, 0.3};
+  drive.start_time = 42;
+  drive.cmd_t = {0, 1.5};
+  drive.cmd_left = {30, 0};
+  drive.cmd_right = {50, 0};
+  drive.channels["x"] = {{0.0, 1.0 / 30, 2.0 / 30}, {0.1, 0.11, 0.12}, {}};
+  drive.channels["pitch"] = {{0.05, 0.15}, {0.01, -0.02}, {}};
+  drive.t_end = 2;
+  calib::Run place;
+  place.name = "ir_wall";
+  place.kind = RunKind::Place;
+  place.placements = {{{0.3, 0, 0}, kNaN}, {{0.35, 0, 0.2}, 0.05}};
+  place.channels["ir0"] = {{0, 1}, {1000, 50}, {}};
+  ds.runs = {drive, place};
+  ds.world.terrain.boxes.push_back({"w", Vec3(0.5, 0, 0.05), Vec3(0.02, 1, 0.1), 0.1, 0, "black_card"});
+  const std::string d = tempDir("roundtrip");
+  writeDataset(ds, d);
+  const Dataset back = loadDataset(d);
+  ASSERT_EQ(back.runs.size(), 2u);
+  EXPECT_EQ(back.robot, "medium");
+  EXPECT_DOUBLE_EQ(back.runs[0].start_time, 42);
+  EXPECT_NEAR(back.runs[0].initial_pose.yaw, 0.3, 1e-9);
+  EXPECT_EQ(back.runs[0].channels.at("x").v, drive.channels["x"].v);
+  EXPECT_EQ(back.runs[0].channels.at("pitch").t.size(), 2u);
+  EXPECT_EQ(back.runs[0].commandAt(2.0), std::make_pair(0.0, 0.0));
+  EXPECT_EQ(back.runs[1].kind, RunKind::Place);
+  ASSERT_EQ(back.runs[1].placements.size(), 2u);
+  EXPECT_TRUE(std::isnan(back.runs[1].placements[0].z));
+  EXPECT_DOUBLE_EQ(back.runs[1].placements[1].z, 0.05);
+  EXPECT_EQ(back.runs[1].channels.at("ir0").v, (std::vector<double>{1000, 50}));
+  EXPECT_EQ(back.world.terrain.boxes.at(0).surface, "black_card");
+}
+
+TEST(Dataset, MissingColumnNamesFileAndColumn) {
+  const DatasetError e = errorOf(makeDataset("missing", "t,cmd_left,x\n0,1,0\n"));
+  EXPECT_NE(e.file().find("straight.csv"), std::string::npos);
+  EXPECT_EQ(e.columnName(), "cmd_right");
+  EXPECT_EQ(e.line(), 1);
+}
+
+TEST(Dataset, NonMonotonicTimeNamesLineAndColumn) {
+  const DatasetError e = errorOf(makeDataset("time", "# comment\nx,t,cmd_left,cmd_right\n0,0,1,1\n0,0.2,,\n0,0.1,,\n"));
+  EXPECT_EQ(e.line(), 5);
+  EXPECT_EQ(e.column(), 2);
+  EXPECT_EQ(e.columnName(), "t");
+  EXPECT_NE(std::string(e.what()).find("straight.csv:5:2"), std::string::npos) << e.what();
+}
+
+TEST(Dataset, NaNAndGarbageCells) {
+  DatasetError e = errorOf(makeDataset("nan", "t,cmd_left,cmd_right,x,yaw\n0,1,1,0,0\n0.1,,,0,nan\n"));
+  EXPECT_EQ(e.line(), 3);
+  EXPECT_EQ(e.column(), 5);
+  EXPECT_EQ(e.columnName(), "yaw");
+  EXPECT_NE(std::string(e.what()).find("NaN"), std::string::npos);
+  e = errorOf(makeDataset("garbage", "t,cmd_left,cmd_right,x\n0,1,1,0\n0.1,,,1.2.3\n"));
+  EXPECT_EQ(e.line(), 3);
+  EXPECT_EQ(e.columnName(), "x");
+  e = errorOf(makeDataset("cells", "t,cmd_left,cmd_right,x\n0,1,1\n"));
+  EXPECT_EQ(e.line(), 2);
+  e = errorOf(makeDataset("halfcmd", "t,cmd_left,cmd_right,x\n0,1,,0\n"));
+  EXPECT_EQ(e.columnName(), "cmd_right");
+  e = errorOf(makeDataset("unknowncol", "t,cmd_left,cmd_right,xx\n0,1,1,0\n"));
+  EXPECT_EQ(e.columnName(), "xx");
+  EXPECT_EQ(e.column(), 4);
+  e = errorOf(makeDataset("range", "t,cmd_left,cmd_right,x\n0,200,1,0\n"));
+  EXPECT_EQ(e.columnName(), "cmd_left");
+}
+
+TEST(Dataset, UnknownSurfaceNamesTheYamlLine) {
+  std::string yaml = kYaml;
+  yaml.replace(yaml.find("white_paper"), 11, "green_cheese");
+  const DatasetError e = errorOf(makeDataset("surface", "t,cmd_left,cmd_right,x\n0,1,1,0\n", yaml));
+  EXPECT_NE(e.file().find("dataset.yaml"), std::string::npos);
+  EXPECT_EQ(e.line(), 6);
+  EXPECT_GT(e.column(), 0);
+  EXPECT_NE(std::string(e.what()).find("green_cheese"), std::string::npos);
+  // ... unless the dataset declares it.
+  const std::string d = makeDataset("surface_ok", "t,cmd_left,cmd_right,x\n0,1,1,0\n",
+                                    "surfaces: [green_cheese]\n" + yaml);
+  EXPECT_NO_THROW(loadDataset(d));
+}
+
+TEST(Dataset, BadYaml) {
+  std::string yaml = kYaml;
+  yaml.replace(yaml.find("sbot-dataset/1"), 14, "sbot-dataset/7");
+  EXPECT_EQ(errorOf(makeDataset("format", "t,cmd_left,cmd_right,x\n0,1,1,0\n", yaml)).line(), 1);
+  yaml = kYaml;
+  yaml.replace(yaml.find("straight.csv"), 12, "missing.csv");
+  const DatasetError e = errorOf(makeDataset("file", "t,cmd_left,cmd_right,x\n0,1,1,0\n", yaml));
+  EXPECT_EQ(e.line(), 8);
+  EXPECT_NE(std::string(e.what()).find("missing.csv"), std::string::npos);
+  yaml = kYaml;
+  yaml.replace(yaml.find("kind: drive"), 11, "kind: dance");
+  EXPECT_NE(std::string(errorOf(makeDataset("kind", "t,cmd_left,cmd_right,x\n0,1,1,0\n", yaml)).what()).find("dance"),
+            std::string::npos);
+  EXPECT_THROW(loadDataset("/nonexistent/dataset"), DatasetError);
+}
+
+}  // namespace
+}  // namespace sbot::calib

@@ -1,0 +1,115 @@
+// The workbench's machinery: worker processes, deterministic replay, generator noise floor, fitting
+// by re-simulation, and the compare report.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "calibration/evaluation.h"
+#include "calibration/fit.h"
+#include "calibration/generator.h"
+#include "calibration/report.h"
+
+namespace sbot::calib {
+namespace {
+
+Dataset smallDataset(const std::vector<EffectConfig>& hidden, std::uint64_t seed = 11, double duration = 5) {
+  GeneratorOptions g;
+  g.seed = seed;
+  g.duration = duration;
+  g.hidden = hidden;
+  g.experiments = {"straight", "spin", "steps"};
+  return generateDataset(g, WorkerPool::global());
+}
+
+TEST(WorkerPool, MapsInWorkersLikeInline) {
+  WorkerPool two(2), one(1);
+  std::function<std::vector<double>(std::size_t)> fn = [](std::size_t i) {
+    return std::vector<double>{static_cast<double>(i), std::sqrt(static_cast<double>(i)), WorkerPool::inWorker() ? 1.0 : 0.0};
+  };
+  std::size_t done = 0;
+  const auto a = two.map<std::vector<double>>(37, fn, [&](std::size_t) { ++done; });
+  const auto b = one.map<std::vector<double>>(37, fn);
+  ASSERT_EQ(a.size(), 37u);
+  EXPECT_EQ(done, 37u);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i][1], b[i][1]);
+    EXPECT_EQ(a[i][2], 1.0) << "ran in a forked worker";
+    EXPECT_EQ(b[i][2], 0.0);
+  }
+  std::function<int(std::size_t)> bad = [](std::size_t i) -> int {
+    if (i == 5) throw std::runtime_error("task five failed");
+    return 0;
+  };
+  try {
+    two.map<int>(10, bad);
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("task five"), std::string::npos);
+  }
+}
+
+TEST(Replay, IsDeterministicAcrossWorkerProcesses) {
+  const Dataset ds = smallDataset({{"speed_scale", {{"scale", 1.05}}, {}, ""}});
+  const ModelSpec m{ds.robot, {{"latency", {{"delay", 0.05}}, {}, ""}}};
+  WorkerPool two(2), one(1);
+  const Evaluation a = evaluate(ds, m, allRuns(ds), EvalOptions(), two);
+  const Evaluation b = evaluate(ds, m, allRuns(ds), EvalOptions(), one);
+  ASSERT_EQ(a.stacked().size(), b.stacked().size());
+  EXPECT_EQ((a.stacked() - b.stacked()).cwiseAbs().maxCoeff(), 0.0) << "bit-identical re-simulation";
+}
+
+TEST(Generator, TrueModelSitsAtTheNoiseFloorAndTheNominalDoesNot) {
+  const Dataset ds = smallDataset({{"speed_scale", {{"scale", 1.06}}, {}, ""}});
+  EXPECT_EQ(ds.runs.size(), 8u);
+  const Evaluation truth = evaluate(ds, {ds.robot, {{"speed_scale", {{"scale", 1.06}}, {}, ""}}}, allRuns(ds),
+                                    EvalOptions(), WorkerPool::global());
+  const Evaluation nominal = evaluate(ds, {ds.robot, {}}, allRuns(ds), EvalOptions(), WorkerPool::global());
+  EXPECT_LT(truth.rmsNormalised(), 1.25) << "tracker, encoder and inclinometer noise as declared";
+  EXPECT_GT(truth.rmsNormalised(), 0.8);
+  EXPECT_GT(nominal.rmsNormalised(), 1.8 * truth.rmsNormalised());
+}
+
+TEST(Fit, RecoversHiddenParametersByResimulation) {
+  struct Case {
+    std::string effect, param;
+    double truth;
+  };
+  for (const Case& c : {Case{"speed_scale", "scale", 1.06}, Case{"motor_lag", "tau", 0.2}}) {
+    const Dataset ds = smallDataset({{c.effect, {{c.param, c.truth}}, {}, ""}}, 13);
+    ModelSpec m{ds.robot, {{c.effect, {}, {}, ""}}};
+    const FitResult r = fitModel(ds, m, freeParamsOf(m, {0}), allRuns(ds), FitOptions(), WorkerPool::global());
+    ASSERT_EQ(r.value.size(), 1u);
+    const double null = EffectRegistry::instance().info(c.effect).params.front().null_value;
+    EXPECT_NEAR(r.value[0], c.truth, 0.05 * std::abs(c.truth - null)) << c.effect;
+    EXPECT_GT(r.stderr_[0], 0) << c.effect;
+    EXPECT_LT(r.rss, 0.5 * r.rss_start) << c.effect;
+  }
+}
+
+TEST(Compare, WritesTablesPlotsAndTheWaterfall) {
+  Dataset ds = smallDataset({{"latency", {{"delay", 0.1}}, {}, ""}}, 17, 4);
+  ds.runs.resize(3);
+  ds.yaml_path = "generated";
+  CompareOptions co;
+  co.out_dir = testing::TempDir() + "sbot_compare_report";
+  const auto sums = writeCompareReport(
+      ds, {{"nominal", {ds.robot, {}}}, {"+latency", {ds.robot, {{"latency", {{"delay", 0.1}}, {}, ""}}}}}, co,
+      WorkerPool::global());
+  ASSERT_EQ(sums.size(), 2u);
+  EXPECT_LT(sums[1].nrms, 0.7 * sums[0].nrms);
+  std::ifstream md(co.out_dir + "/report.md");
+  std::stringstream text;
+  text << md.rdbuf();
+  for (const char* s : {"## Summary", "## Per run and channel", "fit %", "heatmap.png", "waterfall.png", "straight_20"})
+    EXPECT_NE(text.str().find(s), std::string::npos) << s;
+  struct stat st;
+  for (const char* png : {"heatmap.png", "trajectories.png", "residual_time.png", "residual_features.png", "parity.png",
+                          "before_after.png", "waterfall.png"})
+    EXPECT_EQ(::stat((co.out_dir + "/plots/" + png).c_str(), &st), 0) << png << " (plot_report.py)";
+}
+
+}  // namespace
+}  // namespace sbot::calib

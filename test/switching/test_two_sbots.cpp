@@ -1,0 +1,28 @@
+// Decisive cells of the two-connected-s-bot rows (seed Table 4.1, 4.1.3) on the Detailed level:
+// the pair climbs fully at 29 deg and does not topple at 58 deg where a single s-bot topples; the
+// pair passes a 32 mm step going backwards (the holder lifting itself with its gripper arm) where a
+// single s-bot going backwards fails.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "two_sbots_trials.h"
+
+namespace {
+
+constexpr double kDeg = M_PI / 180;
+
+TEST(TwoSbots, SlopeRows) {
+  EXPECT_EQ(two_sbots::pairSlope("detailed", 29 * kDeg, 0, true).label, "full");
+  EXPECT_EQ(two_sbots::pairSlope("detailed", 58 * kDeg, 0, false).label, "topple");
+  EXPECT_NE(two_sbots::pairSlope("detailed", 58 * kDeg, 0, true).label, "topple");
+}
+
+TEST(TwoSbots, StepPassing32mm) {
+  for (int trial = 0; trial < 2; ++trial) {
+    EXPECT_EQ(two_sbots::stepBackward("detailed", 0.032, trial, true, false).label, "pass") << trial;
+    EXPECT_NE(two_sbots::stepBackward("detailed", 0.032, trial, false, false).label, "pass") << trial;
+  }
+}
+
+}  // namespace

@@ -1,0 +1,126 @@
+#!/usr/bin/python3
+"""Outcome of the sbot.h controllers (sbot_controllers/src/obstacle_avoidance.c, phototaxis.c) run
+against the simulator over ~sim_duration simulated seconds, judged from ground truth.
+
+Collision (ground truth): two robots' centres closer than 2 x turret radius - 5 mm, or a robot's
+centre closer than turret radius - 5 mm to an arena wall's inner face (overlap). Checked on every
+ground_truth message (50 Hz sim time) of every robot against the latest pose of the others.
+
+~mode avoidance: no collision at all, and every robot travelled at least ~min_travel [m].
+~mode phototaxis: the mean distance to the lamp fell by at least ~min_gain [m].
+
+The simulator starts paused; the test unpauses it once every controller publishes cmd_speed, so
+the run is judged from t = 0.
+"""
+import math
+import sys
+import threading
+import time
+import unittest
+
+import rosgraph
+import rospy
+import rostest
+from nav_msgs.msg import Odometry
+from std_srvs.srv import Trigger
+
+
+class ControllerOutcome(unittest.TestCase):
+    def setUp(self):
+        rospy.init_node('sbot_api_controller_test', anonymous=True)
+        self.robots = rospy.get_param('~robots')
+        self.mode = rospy.get_param('~mode')
+        self.duration = rospy.get_param('~sim_duration', 120.0)
+        self.radius = rospy.get_param('~turret_radius', 0.057)
+        self.arena = rospy.get_param('~arena_size', 0.0)
+        self.lamp = rospy.get_param('~lamp', [0.0, 0.0])
+        self.lock = threading.Lock()
+        self.pose = {}
+        self.start = {}
+        self.travel = {r: 0.0 for r in self.robots}
+        self.t0 = None
+        self.t_last = 0.0
+        self.collisions = []
+        self.subs = [rospy.Subscriber('/%s/ground_truth' % r, Odometry, self.on_pose, r, queue_size=1000,
+                                      tcp_nodelay=True) for r in self.robots]
+
+    def on_pose(self, msg, robot):
+        p = (msg.pose.pose.position.x, msg.pose.pose.position.y)
+        t = msg.header.stamp.to_sec()
+        with self.lock:
+            if self.t0 is None:
+                self.t0 = t
+            if robot not in self.start:
+                self.start[robot] = p
+            if robot in self.pose:
+                q = self.pose[robot]
+                self.travel[robot] += math.hypot(p[0] - q[0], p[1] - q[1])
+            self.pose[robot] = p
+            self.t_last = max(self.t_last, t)
+            limit = 2 * self.radius - 0.005
+            for other, q in self.pose.items():
+                if other != robot and math.hypot(p[0] - q[0], p[1] - q[1]) < limit:
+                    self.collisions.append('t=%.2f %s-%s %.3f m' % (t - self.t0, robot, other,
+                                                                   math.hypot(p[0] - q[0], p[1] - q[1])))
+            if self.arena > 0:
+                half = self.arena / 2 - (self.radius - 0.005)
+                if abs(p[0]) > half or abs(p[1]) > half:
+                    self.collisions.append('t=%.2f %s-wall at (%.3f, %.3f)' % (t - self.t0, robot, p[0], p[1]))
+
+    def wait_controllers(self, timeout=60.0):
+        master = rosgraph.Master('/sbot_api_controller_test')
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            pubs = {t: n for t, n in master.getSystemState()[0]}
+            if all(any(not n.startswith('/simulator') for n in pubs.get('/%s/cmd_speed' % r, []))
+                   for r in self.robots):
+                return
+            time.sleep(0.2)
+        self.fail('controllers did not start within %.0f s' % timeout)
+
+    def test_outcome(self):
+        rospy.wait_for_service('/sim/unpause', 60.0)
+        self.wait_controllers()
+        for s in self.subs:
+            deadline = time.monotonic() + 20
+            while s.get_num_connections() == 0 and time.monotonic() < deadline:
+                time.sleep(0.05)
+        wall0 = time.monotonic()
+        rospy.ServiceProxy('/sim/unpause', Trigger)()
+        deadline = time.monotonic() + 600
+        while time.monotonic() < deadline:
+            with self.lock:
+                if self.t0 is not None and self.t_last - self.t0 >= self.duration and len(self.pose) == len(self.robots):
+                    break
+            time.sleep(0.05)
+        wall = time.monotonic() - wall0
+        with self.lock:
+            sim = self.t_last - (self.t0 or 0)
+            rospy.loginfo('%s: %.1f s simulated in %.1f s wall (RTM %.1f); travel %s', self.mode, sim, wall,
+                          sim / max(wall, 1e-9), {r: round(d, 2) for r, d in self.travel.items()})
+            print('%s: %.1f s simulated in %.1f s wall; travel %s' % (self.mode, sim, wall,
+                  {r: round(d, 2) for r, d in self.travel.items()}), file=sys.stderr)
+            self.assertGreaterEqual(sim, self.duration - 0.1, 'the simulation did not get far enough')
+            kinds = {}
+            for c in self.collisions:
+                k = c.split()[1]
+                kinds[k] = kinds.get(k, 0) + 1
+            print('collision samples by pair: %s' % kinds, file=sys.stderr)
+            if self.mode == 'avoidance':
+                self.assertEqual(self.collisions, [], '%d collision samples, first: %s' %
+                                 (len(self.collisions), self.collisions[:5]))
+                for r in self.robots:
+                    self.assertGreater(self.travel[r], rospy.get_param('~min_travel', 2.0),
+                                       '%s hardly moved' % r)
+            else:
+                def mean_distance(poses):
+                    return sum(math.hypot(p[0] - self.lamp[0], p[1] - self.lamp[1]) for p in poses.values()) / len(poses)
+                d0, d1 = mean_distance(self.start), mean_distance(self.pose)
+                print('phototaxis: mean distance to the lamp %.2f m -> %.2f m; robot-robot contacts: %d samples'
+                      % (d0, d1, len(self.collisions)), file=sys.stderr)
+                self.assertLess(d1, d0 - rospy.get_param('~min_gain', 1.0),
+                                'mean distance to the lamp %.2f m -> %.2f m' % (d0, d1))
+
+
+if __name__ == '__main__':
+    rostest.rosrun('swarmbot3d', 'sbot_api_controllers', ControllerOutcome)

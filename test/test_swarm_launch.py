@@ -1,0 +1,144 @@
+#!/usr/bin/env python3
+"""rostest (swarm_launch_1.test, swarm_launch_20.test): launch/swarm.launch brings up a working swarm.
+
+For every robot sbot_<i> (i < ~robots):
+  - /sbot_<i>/ground_truth publishes, and the robot moves (its random_walk controller drives it):
+    it ends at least ~min_travel away from where it was first seen, and /sbot_<i>/cmd_speed carries
+    commands;
+  - /tf carries world -> sbot_<i>/base_link (from the simulator) and sbot_<i>/base_link ->
+    sbot_<i>/turret (from /sbot_<i>/robot_state_publisher, the turret joint being revolute).
+
+Private parameters: ~robots (required), ~sim_window [s sim] to watch (default 5), ~min_travel [m]
+(default 0.05), ~timeout [s wall] for everything to come up (default 40).
+"""
+import math
+import threading
+import time
+import unittest
+
+import rospy
+import rostest
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
+from sbot_msgs.msg import TrackSpeed
+from tf2_msgs.msg import TFMessage
+
+PKG = 'swarmbot3d'
+
+
+class SwarmLaunchTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node('test_swarm_launch')
+        cls.robots = int(rospy.get_param('~robots'))
+        cls.sim_window = float(rospy.get_param('~sim_window', 5.0))
+        cls.min_travel = float(rospy.get_param('~min_travel', 0.05))
+        cls.timeout = float(rospy.get_param('~timeout', 40.0))
+        cls.names = ['sbot_%d' % i for i in range(cls.robots)]
+        cls.lock = threading.Lock()
+        cls.first = {}        # robot -> (x, y) first ground truth
+        cls.last = {}         # robot -> (x, y) latest ground truth
+        cls.gt_count = {r: 0 for r in cls.names}
+        cls.cmd_count = {r: 0 for r in cls.names}
+        cls.cmd_nonzero = {r: 0 for r in cls.names}
+        cls.edges = {}        # (parent, child) -> set of publishing nodes
+        cls.clock = None
+        cls.subs = [rospy.Subscriber('/clock', Clock, cls.on_clock),
+                    rospy.Subscriber('/tf', TFMessage, cls.on_tf, queue_size=1000)]
+        for r in cls.names:
+            cls.subs.append(rospy.Subscriber('/%s/ground_truth' % r, Odometry, cls.on_gt, r, queue_size=100))
+            cls.subs.append(rospy.Subscriber('/%s/cmd_speed' % r, TrackSpeed, cls.on_cmd, r, queue_size=100))
+
+        # Wait (wall time) until every robot has reported once, then watch sim_window of sim time.
+        deadline = time.time() + cls.timeout
+        while time.time() < deadline and not rospy.is_shutdown():
+            with cls.lock:
+                if all(cls.gt_count[r] > 0 for r in cls.names) and cls.clock is not None:
+                    break
+            time.sleep(0.1)
+        with cls.lock:
+            cls.start_clock = cls.clock
+        if cls.start_clock is None:
+            return
+        deadline = time.time() + cls.timeout
+        while time.time() < deadline and not rospy.is_shutdown():
+            with cls.lock:
+                if cls.clock >= cls.start_clock + cls.sim_window:
+                    break
+            time.sleep(0.1)
+        with cls.lock:
+            cls.end_clock = cls.clock
+
+    @classmethod
+    def tearDownClass(cls):
+        for s in cls.subs:
+            s.unregister()
+
+    @classmethod
+    def on_clock(cls, msg):
+        with cls.lock:
+            cls.clock = msg.clock.to_sec()
+
+    @classmethod
+    def on_gt(cls, msg, robot):
+        p = msg.pose.pose.position
+        with cls.lock:
+            cls.gt_count[robot] += 1
+            cls.first.setdefault(robot, (p.x, p.y))
+            cls.last[robot] = (p.x, p.y)
+
+    @classmethod
+    def on_cmd(cls, msg, robot):
+        with cls.lock:
+            cls.cmd_count[robot] += 1
+            if msg.left != 0 or msg.right != 0:
+                cls.cmd_nonzero[robot] += 1
+
+    @classmethod
+    def on_tf(cls, msg):
+        node = getattr(msg, '_connection_header', {}).get('callerid', '?')
+        with cls.lock:
+            for t in msg.transforms:
+                cls.edges.setdefault((t.header.frame_id.lstrip('/'), t.child_frame_id.lstrip('/')), set()).add(node)
+
+    def test_0_clock_runs(self):
+        self.assertIsNotNone(self.start_clock, 'no /clock or not every robot published ground_truth within %.0f s'
+                             % self.timeout)
+        self.assertGreaterEqual(self.end_clock, self.start_clock + self.sim_window - 1e-6,
+                                'sim time advanced only %.2f s in %.0f s wall (wanted %.1f s)'
+                                % (self.end_clock - self.start_clock, self.timeout, self.sim_window))
+
+    def test_1_ground_truth(self):
+        with self.lock:
+            silent = [r for r in self.names if self.gt_count[r] == 0]
+        self.assertEqual(silent, [], 'robots without ground_truth messages: %s' % silent)
+
+    def test_2_robots_move(self):
+        with self.lock:
+            travel = {r: math.hypot(self.last[r][0] - self.first[r][0], self.last[r][1] - self.first[r][1])
+                      for r in self.names if r in self.first}
+            no_cmd = [r for r in self.names if self.cmd_nonzero[r] == 0]
+        still = sorted(r for r in self.names if travel.get(r, 0.0) < self.min_travel)
+        self.assertEqual(no_cmd, [], 'robots whose controller sent no non-zero cmd_speed: %s' % no_cmd)
+        self.assertEqual(still, [], 'robots that moved less than %.2f m in %.1f s sim: %s (travel %s)'
+                         % (self.min_travel, self.sim_window, still,
+                            {r: round(travel.get(r, 0.0), 3) for r in still}))
+
+    def test_3_tf_tree(self):
+        with self.lock:
+            edges = dict(self.edges)
+        missing = []
+        for r in self.names:
+            if ('world', '%s/base_link' % r) not in edges:
+                missing.append('world -> %s/base_link' % r)
+            turret = edges.get(('%s/base_link' % r, '%s/turret' % r))
+            if not turret:
+                missing.append('%s/base_link -> %s/turret' % (r, r))
+            elif '/%s/robot_state_publisher' % r not in turret:
+                missing.append('%s/base_link -> %s/turret from /%s/robot_state_publisher (published by %s)'
+                               % (r, r, r, sorted(turret)))
+        self.assertEqual(missing, [], 'missing transforms on /tf: %s' % missing)
+
+
+if __name__ == '__main__':
+    rostest.rosrun(PKG, 'test_swarm_launch', SwarmLaunchTest)

@@ -1,0 +1,67 @@
+#!/usr/bin/env python3
+"""rostest (swarm_manager.test): sbot_0 drives along x on the composite course at 60 units; the
+swarm_manager keeps it Basic on the flat start, switches it to Medium before the 30 mm gap at
+x = 1.5 m and back to Basic behind it. A manual override pins the level."""
+import threading
+import time
+import unittest
+
+import rospy
+import rostest
+from nav_msgs.msg import Odometry
+from sbot_msgs.msg import ModelLevel, TrackSpeed
+from sbot_msgs.srv import SetModelLevel
+
+
+class TestSwarmManager(unittest.TestCase):
+    def test_switches_at_the_gap_and_back(self):
+        rospy.init_node('test_swarm_manager')
+        levels = []  # (x at the switch, level)
+        x = [0.0]
+        lock = threading.Lock()
+
+        def on_odom(m):
+            with lock:
+                x[0] = m.pose.pose.position.x
+
+        def on_level(m):
+            with lock:
+                levels.append((x[0], m.level))
+
+        rospy.Subscriber('/sbot_0/ground_truth', Odometry, on_odom)
+        rospy.Subscriber('/sbot_0/model_level', ModelLevel, on_level)
+        pub = rospy.Publisher('/sbot_0/cmd_speed', TrackSpeed, queue_size=1, latch=True)
+        rospy.wait_for_service('/swarm_manager/set_override', timeout=30.0)
+        pub.publish(TrackSpeed(left=60, right=60))
+        deadline = time.monotonic() + 60.0
+        while time.monotonic() < deadline and not rospy.is_shutdown():
+            with lock:
+                if x[0] > 2.0:
+                    break
+            time.sleep(0.1)
+        with lock:
+            seq = list(levels)
+            final_x = x[0]
+        self.assertGreater(final_x, 2.0, 'the robot did not cross the first gap: %s' % seq)
+        names = [l for _, l in seq]
+        self.assertIn('medium', names, seq)
+        first_medium = next(px for px, l in seq if l == 'medium')
+        self.assertGreater(first_medium, 1.1, seq)  # not before the look-ahead sees the gap
+        self.assertLess(first_medium, 1.5, seq)     # switched before the gap
+        self.assertEqual(names[-1], 'basic', seq)   # demoted behind it
+        override = rospy.ServiceProxy('/swarm_manager/set_override', SetModelLevel)
+        res = override('sbot_0', 'detailed')
+        self.assertTrue(res.success, res.message)
+        deadline = time.monotonic() + 10.0
+        while time.monotonic() < deadline:
+            with lock:
+                if levels and levels[-1][1] == 'detailed':
+                    break
+            time.sleep(0.1)
+        with lock:
+            self.assertEqual(levels[-1][1], 'detailed')
+        self.assertFalse(override('sbot_0', 'nonsense').success)
+
+
+if __name__ == '__main__':
+    rostest.rosrun('swarmbot3d', 'swarm_manager', TestSwarmManager)

@@ -1,0 +1,68 @@
+// The shipped terrain scenarios (config/scenarios/{rough_terrain,composite_course}.yaml) load, and a
+// robot spawned on the rough terrain's height field rests on it at the right height.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "sbot_sim/core/robot_description.h"
+#include "sbot_sim/core/scenario.h"
+#include "sbot_sim/core/terrain.h"
+#include "sbot_sim/core/world.h"
+
+namespace sbot {
+namespace {
+
+const std::string kScenarios = std::string(SWARMBOT3D_SOURCE_DIR) + "/config/scenarios/";
+
+TEST(TerrainScenarios, RoughTerrainRobotRestsOnHeightField) {
+  Scenario s = loadScenario(kScenarios + "rough_terrain.yaml");
+  ASSERT_EQ(s.world.terrain.type, TerrainConfig::Type::Rough);
+  // A much higher range than the scenario's 8 mm so that "on the height field" differs clearly
+  // from "on a plane at z = 0".
+  s.world.terrain.height_range = 0.20;
+  const HeightMap map = makeHeightMap(s.world.terrain);
+  EXPECT_EQ(map.rows, 128);
+  EXPECT_EQ(map.cols, 128);
+  World w(s.world);
+  // Find a gentle, high spot: the robot should rest at ground height + wheel radius there.
+  double best_x = 0, best_y = 0, best_h = -1;
+  for (double x = -2.0; x <= 2.0; x += 0.05) {
+    for (double y = -2.0; y <= 2.0; y += 0.05) {
+      const double h = w.terrainHeight(x, y);
+      double rough = 0;
+      for (double dx : {-0.06, 0.0, 0.06})
+        for (double dy : {-0.06, 0.0, 0.06}) rough = std::max(rough, std::fabs(w.terrainHeight(x + dx, y + dy) - h));
+      if (rough < 0.004 && h > best_h) { best_h = h; best_x = x; best_y = y; }
+    }
+  }
+  ASSERT_GT(best_h, 0.05) << "no gentle high spot in the height map";
+  for (const std::string level : {"simple", "medium"}) {
+    Robot& r = w.addRobot(loadLevel(level), {best_x, best_y, 0.3}, level);
+    r.setSpeed(0, 0);
+    w.stepN(200);
+    const Vec3 p = r.basePose().position;
+    const double ground = w.terrainHeight(p.x(), p.y());
+    EXPECT_NEAR(p.z() - ground, 0.022, 0.006) << level << " base height above the height field";
+    EXPECT_LT(r.linearVelocity().norm(), 0.02) << level << " is not at rest";
+    EXPECT_GT((r.basePose().orientation * Vec3::UnitZ()).z(), std::cos(0.2)) << level << " is not upright";
+    w.removeRobot(level);
+  }
+}
+
+TEST(TerrainScenarios, CompositeCourseLoads) {
+  const Scenario s = loadScenario(kScenarios + "composite_course.yaml");
+  ASSERT_EQ(s.world.terrain.type, TerrainConfig::Type::Composite);
+  EXPECT_EQ(s.world.terrain.boxes.size(), 7u);
+  World w(s.world);
+  // The ramp's top face: 10 deg from its foot at the step top (x 0.245, z 0.115).
+  EXPECT_NEAR(w.terrainHeight(0.245 + 0.2 * std::cos(0.174533), 0), 0.115 + 0.2 * std::sin(0.174533), 0.003);
+  EXPECT_NEAR(w.terrainHeight(-0.4775, 0), 0.0, 1e-6) << "inside the 45 mm gap";
+  EXPECT_NEAR(w.terrainHeight(0.8, 0), 0.1845, 1e-3) << "plateau";
+  Robot& r = w.addRobot(loadLevel(s.robots.at(0).level), s.robots.at(0).pose, s.robots.at(0).name);
+  w.stepN(100);
+  EXPECT_NEAR(r.basePose().position.z(), 0.10 + 0.022, 0.006) << "on the start platform";
+}
+
+}  // namespace
+}  // namespace sbot
