@@ -50,11 +50,17 @@ class GroundPad : public ::testing::TestWithParam<std::pair<double, double>> {};
 TEST_P(GroundPad, MediumFrontSensorReadsTheApiValue) {
   const auto [gap, api] = GetParam();
   const Pose2D at{0.2, -0.1, 0.7};
-  const Pose sensor = spawnPose("medium", at, "ground_0");
+  // Held 1 cm above its resting pose (teleported, not stepped): the floor is then 14 mm below the
+  // sensors, out of their 6 mm range, and a pad can sit at any gap up to 6 mm.
+  auto lifted = [](Pose p) {
+    p.position.z() += 0.01;
+    return p;
+  };
+  const Pose sensor = lifted(spawnPose("medium", at, "ground_0"));
   WorldConfig c = flatWorld(5);
   c.terrain.boxes.push_back(padUnder(sensor, gap));
   World w(c);
-  Robot& r = w.addRobotAt(loadLevel("medium"), spawnPose("medium", at, "base_link"), "sbot_0");
+  Robot& r = w.addRobotAt(loadLevel("medium"), lifted(spawnPose("medium", at, "base_link")), "sbot_0");
   GroundSensors g(w, r);
   EXPECT_NEAR(g.rawDistance(0), bundleMean(gap), 2e-5);
   EXPECT_NEAR(g.response().reading(g.rawDistance(0)), api, 0.10 * api);
@@ -68,7 +74,7 @@ TEST_P(GroundPad, MediumFrontSensorReadsTheApiValue) {
     sum += v;
   }
   EXPECT_NEAR(sum / n, api, std::max(0.5, 0.10 * api));
-  // The other three see the floor 13 mm below: below the API's resolution, 0.
+  // The other three see the floor 14 mm below: out of range, 0.
   const auto all = g.readAll();
   for (int i = 1; i < kGroundSensors; ++i) EXPECT_EQ(all[i], 0u) << "ground_" << i;
   EXPECT_NEAR(g.rawDistance(2), bundleMean(sensor.position.z()), 1e-3);
@@ -95,12 +101,16 @@ TEST(GroundSensors, NothingWithinSixCentimetresReadsZeroAndSkipsEffects) {
   EXPECT_TRUE(std::isinf(g.rawDistance(0)));
   for (unsigned v : g.readAll()) EXPECT_EQ(v, 0u);
   EXPECT_EQ(counter->calls, 0);
-  // On the floor the floor is within 6 cm: the effects are called (the reading still rounds to 0).
+  // Resting on the floor, 4 mm above it: the effects are called and every sensor sees the floor
+  // (a cliff reads 0, flat ground a few units).
   World w2(flatWorld());
   Robot& r2 = w2.addRobot(loadLevel("medium"), {0, 0, 0}, "sbot_0");
   w2.addEffect(counter);
   GroundSensors g2(w2, r2);
-  g2.readAll();
+  for (unsigned v : g2.readAll()) {
+    EXPECT_GE(v, 1u);  // spawned 1 mm above the floor (not stepped): 5 mm -> about 2
+    EXPECT_LE(v, 12u);
+  }
   EXPECT_EQ(counter->calls, 4);
   EXPECT_THROW(g2.read(4), std::out_of_range);
 }
