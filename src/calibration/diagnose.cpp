@@ -341,6 +341,7 @@ DiagnoseResult diagnose(const Dataset& ds, const DiagnoseOptions& opt, WorkerPoo
   out.heldout_rms_before = n_heldout ? std::sqrt(sumRss(cur_fold) / n_heldout) : 0;
   std::vector<int> accepted_idx;  // indices into current.effects that were accepted here
   std::map<std::string, std::vector<std::string>> runners_up;  // accepted effect -> its step's rivals
+  std::map<std::string, std::vector<double>> fold_estimates;    // "effect.param" -> per-fold values
 
   // One fit task: candidate `effect` (empty = none: the baseline, i.e. the current model's
   // accepted parameters refit on the fold) on fold `fold`, starting from `start` values.
@@ -503,6 +504,9 @@ DiagnoseResult diagnose(const Dataset& ds, const DiagnoseOptions& opt, WorkerPoo
         rd.indistinguishable.push_back(rd.ranked[i].effect);
     for (const auto& r : rd.indistinguishable) out.ambiguous.push_back({best.effect, r});
     out.accepted.push_back(best.effect);
+    for (std::size_t j = 0; j < best.params.size(); ++j)
+      for (const auto& fv : best.fold_values)
+        if (j < fv.size()) fold_estimates[best.effect + "." + best.params[j]].push_back(fv[j]);
 
     // Refit every accepted parameter on all runs, from the folds' mean.
     ModelSpec m = current;
@@ -529,6 +533,66 @@ DiagnoseResult diagnose(const Dataset& ds, const DiagnoseOptions& opt, WorkerPoo
       if (rd.ranked[i].delta_bic > opt.bic_threshold && rd.ranked[i].reduction >= opt.min_reduction)
         rivals.push_back(rd.ranked[i].effect);
     runners_up[best.effect] = rivals;
+
+    // Removal check (backward step): an effect accepted earlier that the new one has made
+    // redundant (removing it, all other parameters refit per fold, costs less than the acceptance
+    // bar) is dropped.
+    for (std::size_t a = 0; a + 1 < out.accepted.size() && out.accepted.size() > 1;) {
+      const std::string old_effect = out.accepted[a];
+      ModelSpec without = current;
+      int removed = -1;
+      for (std::size_t i = 0; i < without.effects.size(); ++i)
+        if (without.effects[i].name == old_effect) removed = static_cast<int>(i);
+      if (removed < 0) {
+        ++a;
+        continue;
+      }
+      without.effects.erase(without.effects.begin() + removed);
+      std::vector<int> idx_without;
+      for (int i : accepted_idx)
+        if (i != removed) idx_without.push_back(i > removed ? i - 1 : i);
+      ProgressBar bar4(opt.progress, tag + "checking removal of " + old_effect, K);
+      auto rm = pool.map<FitTask>(
+          K,
+          [&](std::size_t f) {
+            FitTask r;
+            r.fit = fitModel(ds, without, freeParamsOf(without, idx_without), train[f], fo, pool);
+            r.heldout = evaluate(ds, r.fit.model, test[f], fo.eval, pool);
+            return r;
+          },
+          [&](std::size_t) { bar4.tick(); });
+      bar4.finish();
+      std::vector<Evaluation> parts;
+      double rss_without = 0;
+      for (int f = 0; f < K; ++f) {
+        parts.push_back(rm[f].heldout);
+        rss_without += rm[f].heldout.rss();
+      }
+      const double cur_rss = sumRss(cur_fold);
+      const Evaluation merged = merge(parts);
+      const double k = static_cast<double>(candidateParams(ds, old_effect).size());
+      const double n_eff = merge(cur_fold).nEffective();
+      const double dbic = n_eff * std::log(std::max(1e-300, rss_without) / std::max(1e-300, cur_rss)) -
+                          k * std::log(std::max(2.0, n_eff));
+      const bool keep = dbic > opt.bic_threshold && rss_without >= cur_rss * (1 + opt.min_reduction);
+      log("  removal check " + old_effect + ": held-out RSS without it " + fmt(rss_without, 6) + " vs " +
+          fmt(cur_rss, 6) + (keep ? " (kept)" : " (removed)"));
+      if (keep) {
+        ++a;
+        continue;
+      }
+      rd.removed.push_back(old_effect);
+      out.accepted.erase(out.accepted.begin() + a);
+      out.ambiguous.erase(std::remove_if(out.ambiguous.begin(), out.ambiguous.end(),
+                                         [&](const auto& p) { return p.first == old_effect || p.second == old_effect; }),
+                          out.ambiguous.end());
+      accepted_idx = idx_without;
+      out.final_fit = fitModel(ds, without, freeParamsOf(without, accepted_idx), allRuns(ds), fo, pool);
+      current = out.final_fit.model;
+      cur_fold = parts;
+      for (int f = 0; f < K; ++f) cur_train[f] = trainEval(out.final_fit.evaluation, f);
+      (void)merged;
+    }
 
     // Replacement check (stepwise with swaps): an effect accepted earlier may have stood in for
     // one that only now, next to the new effect, shows its worth (e.g. a rate limit imitating a
@@ -624,6 +688,12 @@ DiagnoseResult diagnose(const Dataset& ds, const DiagnoseOptions& opt, WorkerPoo
       cur_fold = best_parts;
       for (int f = 0; f < K; ++f) cur_train[f] = trainEval(out.final_fit.evaluation, f);
       runners_up[new_effect] = runners_up[old_effect];
+      for (int f = 0; f < K; ++f) {
+        const FitResult& fr = sw[best_option * K + f].fit;
+        for (std::size_t q = 0; q < fr.free.size(); ++q)
+          if (fr.free[q].effect == static_cast<int>(fr.model.effects.size()) - 1)
+            fold_estimates[new_effect + "." + fr.free[q].name].push_back(fr.value[q]);
+      }
     }
     out.rounds.push_back(std::move(rd));
   }
@@ -647,9 +717,20 @@ DiagnoseResult diagnose(const Dataset& ds, const DiagnoseOptions& opt, WorkerPoo
       const FreeParam& p = out.final_fit.free[j];
       const std::string& en = out.final_fit.model.effects[p.effect].name;
       if (std::find(out.accepted.begin(), out.accepted.end(), en) == out.accepted.end()) continue;
-      v << "  " << en << "." << p.name << " = " << fmt(out.final_fit.value[j], 5) << " +- "
-        << fmt(1.96 * out.final_fit.stderr_[j], 2) << " " << p.spec.unit << " (95 % interval; null "
-        << fmt(p.spec.null_value, 4) << ")\n";
+      // Interval: the larger of the analytic one ((J'J)^-1 s^2, measurement noise only) and the
+      // spread of the per-fold estimates (which also carries the simulation's own sensitivity).
+      double se = out.final_fit.stderr_[j];
+      auto fe = fold_estimates.find(en + "." + p.name);
+      if (fe != fold_estimates.end() && fe->second.size() >= 2) {
+        double m = 0, ss = 0;
+        for (double x : fe->second) m += x / fe->second.size();
+        for (double x : fe->second) ss += (x - m) * (x - m);
+        const double sd = std::sqrt(ss / (fe->second.size() - 1));
+        se = std::max(se, sd / std::sqrt(static_cast<double>(fe->second.size())));
+      }
+      out.interval95.push_back(1.96 * se);
+      v << "  " << en << "." << p.name << " = " << fmt(out.final_fit.value[j], 5) << " +- " << fmt(1.96 * se, 2)
+        << " " << p.spec.unit << " (95 % interval; null " << fmt(p.spec.null_value, 4) << ")\n";
     }
     for (std::size_t r = 0; r < out.rounds.size(); ++r) {
       const auto& rd = out.rounds[r];
@@ -658,6 +739,9 @@ DiagnoseResult diagnose(const Dataset& ds, const DiagnoseOptions& opt, WorkerPoo
         << fmt(rd.ranked.front().delta_bic, 5) << ", held-out error -" << fmt(100 * rd.ranked.front().reduction, 3)
         << " %\n";
     }
+    for (std::size_t r = 0; r < out.rounds.size(); ++r)
+      for (const auto& a : out.rounds[r].removed)
+        v << "  after step " << r + 1 << ": " << a << " removed (redundant next to the later effects)\n";
     for (std::size_t r = 0; r < out.rounds.size(); ++r)
       for (const auto& [a, b] : out.rounds[r].swaps)
         v << "  after step " << r + 1 << ": " << a << " replaced by " << b

@@ -58,6 +58,7 @@ struct DiagnoseRound {
   std::string accepted;                 ///< empty when none passed
   std::vector<std::string> indistinguishable;  ///< passing candidates within the margin of the best
   std::vector<std::pair<std::string, std::string>> swaps;  ///< (replaced, replacement) after this step
+  std::vector<std::string> removed;     ///< earlier effects dropped as redundant after this step
 };
 
 struct StructureNote {
@@ -76,6 +77,9 @@ struct DiagnoseResult {
   std::vector<std::string> accepted;
   ModelSpec final_model;
   FitResult final_fit;          ///< all accepted parameters refit on all runs
+  /// 95 % half-widths of the accepted parameters (verdict order): max of the analytic interval and
+  /// the spread of the per-fold estimates.
+  std::vector<double> interval95;
   double heldout_rms_before = 0, heldout_rms_after = 0;  ///< normalised held-out RMS
   std::vector<StructureNote> structure;   ///< of the final model's residuals
   bool structure_flagged = false;

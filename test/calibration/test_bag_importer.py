@@ -17,7 +17,7 @@ import genpy.dynamic
 import rosbag
 import rospy
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+HERE = os.path.dirname(os.path.realpath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "src", "calibration"))
 import bag_to_dataset  # noqa: E402
