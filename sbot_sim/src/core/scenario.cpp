@@ -204,6 +204,11 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
   if (seed < 0 || seed != std::floor(seed)) throw ConfigError(file, "seed", "must be a non-negative integer");
   s.world.seed = static_cast<std::uint64_t>(seed);
   s.duration = f.number("duration", 0);
+  s.effects_file = f.text("effects", "");
+  if (!s.effects_file.empty() && s.effects_file[0] != '/') {
+    const auto slash = file.find_last_of('/');
+    if (slash != std::string::npos) s.effects_file = file.substr(0, slash + 1) + s.effects_file;
+  }
   if (s.duration < 0) throw ConfigError(file, "duration", "must be >= 0");
   parseWorld(f.node("world"), s.world, file);
 

@@ -1,5 +1,7 @@
 #include "sim_ros_interface.h"
 
+#include "sbot_sim/core/effects/effects_file.h"
+
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -138,6 +140,10 @@ std::unique_ptr<sbot::World> SimRosInterface::buildWorld() const {
   for (const sbot::RobotSpawn& s : scenario_.robots)
     world->addRobot(sbot::loadLevel(s.level), s.pose, s.name);
   sbot::swarm::addScenarioLinks(*world, scenario_.links);  // static links (seed 2.2.3)
+  if (!scenario_.effects_file.empty()) {
+    // The calibration workbench's effects file: throws ConfigError naming file and field.
+    for (const sbot::EffectPtr& e : sbot::loadEffectsFile(scenario_.effects_file)) world->addEffect(e);
+  }
   return world;
 }
 

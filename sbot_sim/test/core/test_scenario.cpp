@@ -58,6 +58,12 @@ TEST(Scenario, ErrorsNameFileAndField) {
   EXPECT_NE(errorOf("world: {gravity: .nan}").find("'world.gravity': must be finite"), std::string::npos);
 }
 
+TEST(Scenario, EffectsFileIsRelativeToTheScenario) {
+  EXPECT_EQ(parseScenario("effects: fitted.yaml", "/data/run/scenario.yaml").effects_file, "/data/run/fitted.yaml");
+  EXPECT_EQ(parseScenario("effects: /abs/e.yaml", "/data/s.yaml").effects_file, "/abs/e.yaml");
+  EXPECT_EQ(parseScenario("seed: 1", "/data/s.yaml").effects_file, "");
+}
+
 TEST(Scenario, MissingFileIsReported) {
   try {
     loadScenario("/nonexistent/scenario.yaml");

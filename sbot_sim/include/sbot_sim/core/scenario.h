@@ -48,6 +48,9 @@ struct Scenario {
   std::vector<RobotSpawn> robots;
   std::vector<LinkSpawn> links;  ///< after the robots; every name is one of `robots`
   double duration = 0;           ///< [s], 0 = unlimited
+  /// Effects file (`effects: FILE`, relative to the scenario): the calibration workbench's format,
+  /// so an accepted effect becomes part of the simulation. Empty = none.
+  std::string effects_file;
 };
 
 /// Parse a scenario. `robot_count` >= 0 overrides swarm.count. Throws ConfigError naming the file
