@@ -15,6 +15,7 @@
 #include <sbot_msgs/Slope.h>
 #include <sbot_msgs/SoundState.h>
 #include <sensor_msgs/Imu.h>
+#include <sensor_msgs/Illuminance.h>
 #include <sensor_msgs/Range.h>
 #include <visualization_msgs/MarkerArray.h>
 #include <yaml-cpp/yaml.h>
@@ -89,6 +90,9 @@ RobotModulesRos::RobotModulesRos(ros::NodeHandle nh, ros::NodeHandle pnh, const 
     ir_pubs_.push_back(adv(Tag<sensor_msgs::Range>(), "proximity/ir_" + std::to_string(k), "ir_" + std::to_string(k), q, false));
   pubs_["ground"] = adv(Tag<sbot_msgs::GroundArray>(), "ground", "ground", q, false);
   pubs_["light"] = adv(Tag<sbot_msgs::LightArray>(), "light", "light", q, false);
+  for (int k = 0; k < sn::kLightSensors; ++k)
+    light_pubs_.push_back(adv(Tag<sensor_msgs::Illuminance>(), "light/sensor_" + std::to_string(k),
+                              "light_" + std::to_string(k), q, false));
   pubs_["slope"] = adv(Tag<sbot_msgs::Slope>(), "slope", "slope", q, false);
   pubs_["imu"] = adv(Tag<sensor_msgs::Imu>(), "imu", "imu", q, false);
   pubs_["sound"] = adv(Tag<sbot_msgs::SoundState>(), "sound", "sound", q, false);
@@ -173,6 +177,15 @@ bool RobotModulesRos::due(const std::string& channel, double t) {
   return subs_[channel] > 0;
 }
 
+bool RobotModulesRos::dueWithSingles(const std::string& channel, const std::string& single_prefix, int count,
+                                     double t, bool& any_single) {
+  const bool was_due = t + 1e-9 >= rates_[channel].next;
+  any_single = false;
+  if (was_due)
+    for (int k = 0; k < count; ++k) any_single = any_single || subs_[single_prefix + std::to_string(k)] > 0;
+  return due(channel, t) || (was_due && any_single);
+}
+
 void RobotModulesRos::update(double dt, double sim_time) {
   if (!robot_) return;
   suite_->update(dt);
@@ -197,12 +210,8 @@ void RobotModulesRos::update(double dt, double sim_time) {
   };
 
   {
-    Rate& r = rates_["proximity"];
-    const bool was_due = sim_time + 1e-9 >= r.next;
     bool any_ir = false;
-    if (was_due)
-      for (int k = 0; k < sn::kProximitySensors; ++k) any_ir = any_ir || subs_["ir_" + std::to_string(k)] > 0;
-    const bool want = due("proximity", sim_time) || (was_due && any_ir);
+    const bool want = dueWithSingles("proximity", "ir_", sn::kProximitySensors, sim_time, any_ir);
     if (want && suite_->available(sn::SensorChannel::Proximity)) {
       const auto all = suite_->getAllProximitySensors();
       sbot_msgs::ProximityArray m;
@@ -233,12 +242,32 @@ void RobotModulesRos::update(double dt, double sim_time) {
     for (int k = 0; k < sn::kGroundSensors; ++k) m.readings[k] = static_cast<uint16_t>(all[k]);
     pubs_["ground"].publish(m);
   }
-  if (due("light", sim_time) && suite_->available(sn::SensorChannel::Light)) {
-    sbot_msgs::LightArray m;
-    m.header = header(turret);
-    const auto all = suite_->getAllLightSensors();
-    for (int k = 0; k < sn::kLightSensors; ++k) m.readings[k] = static_cast<uint16_t>(all[k]);
-    pubs_["light"].publish(m);
+  {
+    // The compact array and, for whoever subscribes, one sensor_msgs/Illuminance per sensor (the
+    // same noisy, saturating reading converted to lux: 1 mcd/cm^2 = 10 lx).
+    bool any_single = false;
+    const bool want = dueWithSingles("light", "light_", sn::kLightSensors, sim_time, any_single);
+    if (want && suite_->available(sn::SensorChannel::Light)) {
+      sbot_msgs::LightArray m;
+      m.header = header(turret);
+      const auto all = suite_->getAllLightSensors();
+      for (int k = 0; k < sn::kLightSensors; ++k) m.readings[k] = static_cast<uint16_t>(all[k]);
+      pubs_["light"].publish(m);
+      if (any_single && suite_->light()) {
+        const sn::LightSensorParams& lp = suite_->light()->params();
+        constexpr double kLuxPerMcdPerCm2 = 10.0;  // 1e-3 cd / 1e-4 m^2
+        for (int k = 0; k < sn::kLightSensors; ++k) {
+          if (subs_["light_" + std::to_string(k)] <= 0) continue;
+          sensor_msgs::Illuminance il;
+          il.header = header(name_ + "/light_" + std::to_string(k));
+          il.illuminance = all[k] * lp.unit * kLuxPerMcdPerCm2;
+          // Uniform relative noise +-noise has variance (noise * value)^2 / 3; 0 = unknown (REP).
+          const double sd = lp.noise * il.illuminance;
+          il.variance = sd * sd / 3.0;
+          light_pubs_[k].publish(il);
+        }
+      }
+    }
   }
   if (due("slope", sim_time)) {
     sbot_msgs::Slope m;

@@ -85,6 +85,11 @@ class RobotModulesRos {
     double next = 0;
   };
   bool due(const std::string& channel, double t);
+  /// A channel with a compact array topic (key `channel`) and optional per-sensor topics (keys
+  /// single_prefix + k, k < count): true when its period has come and anyone listens to either;
+  /// any_single says whether the per-sensor messages are wanted.
+  bool dueWithSingles(const std::string& channel, const std::string& single_prefix, int count, double t,
+                      bool& any_single);
   void publishAvailable();
   void publishMarkers(const ros::Time& stamp);
   void publishRawCamera(const ros::Time& stamp);
@@ -110,7 +115,8 @@ class RobotModulesRos {
   double next_any_ = 0;  ///< [s] earliest rates_[*].next
   std::map<std::string, ros::Publisher> pubs_;
   std::map<std::string, int> subs_;  ///< subscriber count per channel / "ir_<k>" (connect callbacks)
-  std::vector<ros::Publisher> ir_pubs_;
+  std::vector<ros::Publisher> ir_pubs_;     ///< proximity/ir_<k> (sensor_msgs/Range)
+  std::vector<ros::Publisher> light_pubs_;  ///< light/sensor_<k> (sensor_msgs/Illuminance)
   ros::Subscriber leds_sub_, speaker_sub_;
   ros::ServiceServer set_gripper_srv_, set_side_arm_srv_, set_leds_srv_, set_rate_srv_;
 };

@@ -9,7 +9,7 @@ import rospy
 import rostest
 from sbot_msgs.msg import GripperState, LightArray, ProximityArray, SensorsAvailable, Slope
 from sbot_msgs.srv import (SetAmbientLight, SetGripper, SetLamp, SetLeds, SetSamplingRate, SetSideArm)
-from sensor_msgs.msg import CameraInfo, Image, Range
+from sensor_msgs.msg import CameraInfo, Illuminance, Image, Range
 
 
 class Collect:
@@ -86,6 +86,31 @@ class Modules(unittest.TestCase):
         r = rospy.wait_for_message('/sbot_0/proximity/ir_3', Range, 20)
         self.assertEqual(r.radiation_type, Range.INFRARED)
         self.assertEqual(r.header.frame_id, 'sbot_0/ir_3')
+
+    def test_illuminance_per_light_sensor(self):
+        # Each light sensor also on light/sensor_<k> as sensor_msgs/Illuminance: the same reading
+        # (same stamp) in lux, 0.1685 mcd/cm^2 per unit (Table 2.10) and 1 mcd/cm^2 = 10 lx.
+        arrays, singles = {}, {}
+        subs = [rospy.Subscriber('/sbot_0/light', LightArray, lambda m: arrays.setdefault(m.header.stamp, m.readings))]
+        for k in range(8):
+            subs.append(rospy.Subscriber('/sbot_0/light/sensor_%d' % k, Illuminance,
+                                         lambda m, k=k: singles.setdefault((m.header.stamp, k), m)))
+        deadline = time.time() + 20
+        common = []
+        while time.time() < deadline and len(common) < 3:
+            time.sleep(0.2)
+            common = [st for st in list(arrays) if all((st, k) in singles for k in range(8))]
+        for s in subs:
+            s.unregister()
+        self.assertGreaterEqual(len(common), 3, 'per-sensor Illuminance messages with the array\'s stamps')
+        lit = 0
+        for st in common:
+            for k in range(8):
+                m = singles[(st, k)]
+                self.assertEqual(m.header.frame_id, 'sbot_0/light_%d' % k)
+                self.assertAlmostEqual(m.illuminance, arrays[st][k] * 1.685, places=3)
+                lit += m.illuminance > 0
+        self.assertGreater(lit, 0, 'the lamp lights some sensor')
 
     def test_gripper_clamps_and_moves(self):
         srv = rospy.ServiceProxy('/sbot_0/set_gripper', SetGripper)
