@@ -65,6 +65,7 @@ World::~World() {
   }
   if (heightfield_data_) dGeomHeightfieldDataDestroy(heightfield_data_);
   dJointGroupDestroy(contacts_);
+  if (query_ray_) dGeomDestroy(query_ray_);
   dSpaceDestroy(static_space_);
   dSpaceDestroy(space_);
   dWorldDestroy(world_);
@@ -246,7 +247,10 @@ void rayAgainstGeom(RayQuery& q, dGeomID ray, dGeomID other) {
 void rayCallback(void* data, dGeomID o1, dGeomID o2) {
   auto& q = *static_cast<RayQuery*>(data);
   if (dGeomIsSpace(o1) || dGeomIsSpace(o2)) {
-    dSpaceCollide2(o1, o2, data, &rayCallback);  // descend into a robot's space
+    // Descend into a robot's space, unless it is the ignored robot's (skips its ~20 geoms at once).
+    const dGeomID sub = dGeomIsSpace(o1) ? o1 : o2;
+    if (q.ignore && sub == reinterpret_cast<dGeomID>(q.ignore->space())) return;
+    dSpaceCollide2(o1, o2, data, &rayCallback);
     return;
   }
   const bool first_is_ray = dGeomGetClass(o1) == dRayClass;
@@ -255,17 +259,24 @@ void rayCallback(void* data, dGeomID o1, dGeomID o2) {
 
 }  // namespace
 
+dGeomID World::queryRay(double length) const {
+  if (!query_ray_) {
+    query_ray_ = dCreateRay(nullptr, length);
+    dGeomRaySetClosestHit(query_ray_, 1);
+  }
+  dGeomRaySetLength(query_ray_, length);
+  return query_ray_;
+}
+
 RayHit World::castRay(const Vec3& origin, const Vec3& direction, double length, const Robot* ignore) const {
   RayHit best;
   best.distance = length;
-  dGeomID ray = dCreateRay(nullptr, length);
+  dGeomID ray = queryRay(length);
   const Vec3 d = direction.normalized();
   dGeomRaySet(ray, origin.x(), origin.y(), origin.z(), d.x(), d.y(), d.z());
-  dGeomRaySetClosestHit(ray, 1);
   RayQuery query{ignore, &best};
   dSpaceCollide2(ray, reinterpret_cast<dGeomID>(space_), &query, &rayCallback);
   dSpaceCollide2(ray, reinterpret_cast<dGeomID>(static_space_), &query, &rayCallback);
-  dGeomDestroy(ray);
   return best;
 }
 
@@ -275,13 +286,12 @@ double World::terrainHeight(double x, double y) const {
                     ? -std::numeric_limits<double>::infinity()
                     : 0.0;
   constexpr double kTop = 100.0;
-  dGeomID ray = dCreateRay(nullptr, 2 * kTop);
+  dGeomID ray = queryRay(2 * kTop);
   dGeomRaySet(ray, x, y, kTop, 0, 0, -1);
   for (dGeomID g : static_geoms_) {
     dContactGeom c;
     if (dCollide(ray, g, 1, &c, sizeof(c)) == 1) best = std::max(best, kTop - c.depth);
   }
-  dGeomDestroy(ray);
   return std::isfinite(best) ? best : 0.0;
 }
 

@@ -88,6 +88,10 @@ class World {
   dWorldID world_ = nullptr;
   dSpaceID space_ = nullptr;
   dSpaceID static_space_ = nullptr;
+  /// One ray geom (in no space) reused by castRay/terrainHeight: creating and destroying a geom per
+  /// ray cost ~10 % of a sensor-reading Medium step. Makes a World unsafe to query from two threads.
+  mutable dGeomID query_ray_ = nullptr;
+  dGeomID queryRay(double length) const;  ///< query_ray_ with this length
   dJointGroupID contacts_ = nullptr;
   std::vector<dGeomID> static_geoms_;
   std::map<dGeomID, std::string> static_material_;
