@@ -439,6 +439,7 @@ def build(level, p):
         "gear_ratio": tr["gear_ratio"],
         "rotor_inertia": tr["rotor_inertia_kgm2"],
         "backdrive_force": tr["friction_force_N"],
+        "drive": tr.get("drive", "wheels"),
     }
     sc["turret"] = {"joint": "turret_joint", "speed": api["speed_rads"], "unit": api["unit_rad"],
                     "range_units": api["range_units"], "max_torque": api["max_torque_Nm"],

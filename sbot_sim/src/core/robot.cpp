@@ -43,12 +43,30 @@ Robot::Robot(World& world, const RobotDescription& description, const std::strin
   build(base_pose);
 }
 
-Robot::~Robot() {
+Robot::~Robot() { destroyModel(); }
+
+void Robot::destroyModel() {
   for (auto& h : hinges_) dJointDestroy(h.id);
   for (dJointID j : loop_joints_) dJointDestroy(j);
+  for (dJointID j : {drive_linear_, drive_angular_})
+    if (j) dJointDestroy(j);
   for (dGeomID g : geoms_) dGeomDestroy(g);
   if (space_) dSpaceDestroy(space_);
   for (dBodyID b : bodies_) dBodyDestroy(b);
+  bodies_.clear();
+  geoms_.clear();
+  geom_infos_.clear();
+  space_ = nullptr;
+  hinges_.clear();
+  loop_joints_.clear();
+  loop_index_.clear();
+  hinge_index_.clear();
+  link_index_.clear();
+  left_hinges_.clear();
+  right_hinges_.clear();
+  turret_hinge_ = -1;
+  drive_linear_ = drive_angular_ = nullptr;
+  drive_torque_[0] = drive_torque_[1] = 0;
 }
 
 void Robot::build(const Pose& base_pose) {
@@ -181,9 +199,52 @@ void Robot::build(const Pose& base_pose) {
   for (const auto& jn : d.treels.left_joints) left_hinges_.push_back(hinge_index_.at(jn));
   for (const auto& jn : d.treels.right_joints) right_hinges_.push_back(hinge_index_.at(jn));
   if (!d.turret.joint.empty()) turret_hinge_ = hinge_index_.at(d.turret.joint);
-  addReflectedRotorInertia(left_hinges_);
-  addReflectedRotorInertia(right_hinges_);
+  if (d.treels.drive == "body") {
+    buildBodyDrive();
+  } else {
+    addReflectedRotorInertia(left_hinges_);
+    addReflectedRotorInertia(right_hinges_);
+  }
   addLoopJoints(world_T_link, link_group);
+}
+
+void Robot::buildBodyDrive() {
+  // Track width: lateral distance between the left and right driven wheels, in base_link.
+  const Pose base_inv = basePose().inverse();
+  auto mean_y = [&](const std::vector<int>& side) {
+    double sum = 0;
+    for (int i : side) sum += (base_inv * bodyPose(bodies_[hinges_[i].child_body])).position.y();
+    return sum / side.size();
+  };
+  drive_track_width_ = std::abs(mean_y(left_hinges_) - mean_y(right_hinges_));
+  if (!(drive_track_width_ > 1e-4))
+    throw ConfigError(description_->sidecar_path, "treels.drive",
+                      "body drive needs left and right driven wheels apart, found a track width of " +
+                          std::to_string(drive_track_width_) + " m");
+  dBodyID chassis = baseBody();
+  drive_linear_ = dJointCreateLMotor(world_.odeWorld(), nullptr);
+  dJointAttach(drive_linear_, chassis, nullptr);
+  dJointSetLMotorNumAxes(drive_linear_, 2);
+  dJointSetLMotorAxis(drive_linear_, 0, 1, 1, 0, 0);  // rel 1: axes fixed in the chassis
+  dJointSetLMotorAxis(drive_linear_, 1, 1, 0, 1, 0);
+  dJointSetFeedback(drive_linear_, &drive_linear_fb_);
+  drive_angular_ = dJointCreateAMotor(world_.odeWorld(), nullptr);
+  dJointAttach(drive_angular_, chassis, nullptr);
+  dJointSetAMotorMode(drive_angular_, dAMotorUser);
+  dJointSetAMotorNumAxes(drive_angular_, 1);
+  dJointSetAMotorAxis(drive_angular_, 0, 1, 0, 0, 1);
+  dJointSetFeedback(drive_angular_, &drive_angular_fb_);
+  dJointSetLMotorParam(drive_linear_, dParamFMax, 0);  // until the first applyCommands
+  dJointSetAMotorParam(drive_angular_, dParamFMax, 0);
+}
+
+double Robot::bodyDriveTrackSpeed(int side) const {
+  // Chassis velocity in its own frame: forward component and yaw rate.
+  dBodyID chassis = baseBody();
+  const Quat q = bodyPose(chassis).orientation;
+  const Vec3 v = q.inverse() * vec(dBodyGetLinearVel(chassis));
+  const Vec3 w = q.inverse() * vec(dBodyGetAngularVel(chassis));
+  return v.x() + (side == 0 ? -1 : 1) * 0.5 * drive_track_width_ * w.z();
 }
 
 void Robot::addLoopJoints(const std::map<std::string, Pose>& world_T_link,
@@ -326,12 +387,14 @@ void Robot::setTrackSpeeds(double left_mps, double right_mps) {
 }
 
 double Robot::trackSpeedLeft() const {
+  if (drive_linear_) return bodyDriveTrackSpeed(0);
   double sum = 0;
   for (int i : left_hinges_) sum += hingeRate(hinges_[i]) * description_->wheelRadius(hinges_[i].name);
   return left_hinges_.empty() ? 0 : sum / left_hinges_.size();
 }
 
 double Robot::trackSpeedRight() const {
+  if (drive_linear_) return bodyDriveTrackSpeed(1);
   double sum = 0;
   for (int i : right_hinges_) sum += hingeRate(hinges_[i]) * description_->wheelRadius(hinges_[i].name);
   return right_hinges_.empty() ? 0 : sum / right_hinges_.size();
@@ -350,8 +413,10 @@ void Robot::getTrackTorque(int* left, int* right) const {
     return t;
   };
   const double unit = description_->treels.torque_unit;
-  if (left) *left = roundToUnits(sum(left_hinges_) / unit, kApiLimit);
-  if (right) *right = roundToUnits(sum(right_hinges_) / unit, kApiLimit);
+  const double tl = drive_linear_ ? drive_torque_[0] : sum(left_hinges_);
+  const double tr = drive_linear_ ? drive_torque_[1] : sum(right_hinges_);
+  if (left) *left = roundToUnits(tl / unit, kApiLimit);
+  if (right) *right = roundToUnits(tr / unit, kApiLimit);
 }
 
 bool Robot::setTurretRotation(int pos) {
@@ -430,7 +495,9 @@ void Robot::applyCommands(double dt, const std::vector<EffectPtr>& effects) {
       dJointSetHingeParam(h.id, dParamFMax, share);
     }
   };
-  if (passive_) {
+  if (drive_linear_) {
+    applyBodyDrive(cmd);
+  } else if (passive_) {
     // Motors off: the gears resist rolling with back-drive friction; pulling the robot takes
     // backdrive_force in total, half of it on each track.
     const double holding = 0.5 * tr.backdrive_force * tr.wheel_radius;  // [N m] per track
@@ -453,6 +520,42 @@ void Robot::applyCommands(double dt, const std::vector<EffectPtr>& effects) {
   }
 }
 
+void Robot::applyBodyDrive(const TrackCommand& cmd) {
+  const TreelsSemantics& tr = description_->treels;
+  for (int i : left_hinges_) dJointSetHingeParam(hinges_[i].id, dParamFMax, 0);  // wheels roll freely
+  for (int i : right_hinges_) dJointSetHingeParam(hinges_[i].id, dParamFMax, 0);
+  // Traction: mu(track, ground) * weight, scaled by how upright the chassis is (no push when toppled).
+  double mass = 0;
+  for (dBodyID b : bodies_) {
+    dMass m;
+    dBodyGetMass(b, &m);
+    mass += m.mass;
+  }
+  const Vec3 up = bodyPose(baseBody()).orientation * Vec3::UnitZ();
+  // The wheels are passive supports (frictionless, like casters: friction at the wheel contacts
+  // would tip the light robot over in every turn); the drive's grip is the track material's.
+  const double traction = world_.config().contact.muFor("track", "ground") * mass *
+                          world_.config().gravity * std::max(0.0, up.z());
+  double v = 0, yaw_rate = 0, f_max = 0, t_max = 0;
+  if (passive_) {
+    f_max = std::min(traction, tr.backdrive_force);  // gear back-drive: the pull needed to move it
+    t_max = 0.5 * f_max * drive_track_width_;
+  } else {
+    const double f_left = std::max(0.0, cmd.max_torque_left) / tr.wheel_radius;  // [N] per track
+    const double f_right = std::max(0.0, cmd.max_torque_right) / tr.wheel_radius;
+    v = 0.5 * (cmd.left + cmd.right);
+    yaw_rate = (cmd.right - cmd.left) / drive_track_width_;
+    f_max = std::min(traction, f_left + f_right);
+    t_max = 0.5 * drive_track_width_ * std::min(traction, std::min(f_left, f_right) * 2);
+  }
+  dJointSetLMotorParam(drive_linear_, dParamVel, v);
+  dJointSetLMotorParam(drive_linear_, dParamFMax, f_max);
+  dJointSetLMotorParam(drive_linear_, dParamVel2, 0);  // no side slip below the traction limit
+  dJointSetLMotorParam(drive_linear_, dParamFMax2, traction);
+  dJointSetAMotorParam(drive_angular_, dParamVel, yaw_rate);
+  dJointSetAMotorParam(drive_angular_, dParamFMax, t_max);
+}
+
 void Robot::readFeedback() {
   for (auto& h : hinges_) {
     const double raw = dJointGetHingeAngle(h.id);
@@ -463,6 +566,16 @@ void Robot::readFeedback() {
     dVector3 a;
     dJointGetHingeAxis(h.id, a);
     h.effort = vec(h.feedback.t1).dot(Vec3(a[0], a[1], a[2]));
+  }
+  if (drive_linear_) {
+    // Motor forces back to per-track axle torques: forward force shared equally, yaw torque as a
+    // force couple of the two tracks.
+    const Quat q = bodyPose(baseBody()).orientation;
+    const double forward = (q.inverse() * vec(drive_linear_fb_.f1)).x();
+    const double yaw = (q.inverse() * vec(drive_angular_fb_.t1)).z();
+    const double r = description_->treels.wheel_radius;
+    drive_torque_[0] = (0.5 * forward - yaw / drive_track_width_) * r;
+    drive_torque_[1] = (0.5 * forward + yaw / drive_track_width_) * r;
   }
 }
 

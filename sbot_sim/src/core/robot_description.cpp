@@ -148,6 +148,9 @@ void parseSidecar(RobotDescription& d) {
   tr.rotor_inertia = get<double>(t, "rotor_inertia", tr.rotor_inertia, file, "treels.");
   tr.backdrive_force = get<double>(t, "backdrive_force", tr.backdrive_force, file, "treels.");
   if (tr.rotor_inertia < 0) throw ConfigError(file, "treels.rotor_inertia", "must be >= 0");
+  tr.drive = get<std::string>(t, "drive", tr.drive, file, "treels.");
+  if (tr.drive != "wheels" && tr.drive != "body")
+    throw ConfigError(file, "treels.drive", "expected 'wheels' or 'body', found '" + tr.drive + "'");
   if (tr.left_joints.empty() || tr.right_joints.empty())
     throw ConfigError(file, "treels.left_joints/right_joints", "each track needs at least one driven joint");
   if (!(tr.wheel_radius > 0)) throw ConfigError(file, "treels.wheel_radius", "must be > 0");

@@ -178,5 +178,85 @@ TEST(Treels, PassiveRobotBreaksAwayAtTheSeeds1_2Newton) {
   EXPECT_NEAR(breakawayForce(), 1.2, 0.15) << "pull force [N] at which a passive s-bot starts rolling";
 }
 
+// ---- Fast level: body drive in 1/50 g at 100 ms steps (sidecar treels.drive: body) -------------
+
+WorldConfig fastWorld() {
+  const RobotDescription& d = loadLevel("fast");
+  WorldConfig c;
+  c.step = d.recommended_step;
+  c.gravity = d.gravity;
+  return c;
+}
+
+TEST(TreelsFast, SameSteadySpeedAsTheOtherLevels) {
+  ASSERT_EQ(loadLevel("fast").treels.drive, "body");
+  World w(fastWorld());
+  Robot& r = w.addRobot(loadLevel("fast"), {0, 0, 0}, "sbot_0");
+  r.setSpeed(50, 50);
+  runFor(w, 2.0);
+  const Vec3 p0 = r.basePose().position;
+  runFor(w, 3.0);
+  const Vec3 p1 = r.basePose().position;
+  EXPECT_NEAR((p1 - p0).head<2>().norm() / 3.0, 0.140, 0.140 * 0.03) << "seed 2.1.3: the same steady speed";
+  EXPECT_GT(p1.x() - p0.x(), 0.99 * (p1 - p0).head<2>().norm()) << "straight ahead";
+  EXPECT_GT((r.basePose().orientation * Vec3::UnitZ()).z(), 0.99) << "upright";
+  int l, rr;
+  r.getSpeed(&l, &rr);
+  EXPECT_NEAR(l, 50, 1);
+  EXPECT_NEAR(rr, 50, 1);
+}
+
+TEST(TreelsFast, SpinsAtTheDifferentialDriveRate) {
+  World w(fastWorld());
+  Robot& r = w.addRobot(loadLevel("fast"), {0, 0, 0}, "sbot_0");
+  r.setSpeed(-20, 20);
+  runFor(w, 1.0);
+  double turned = 0, last = r.basePose().yaw();
+  const Vec3 start = r.basePose().position;
+  for (int i = 0; i < 20; ++i) {  // 2 s
+    w.step();
+    turned += wrapAngle(r.basePose().yaw() - last);
+    last = r.basePose().yaw();
+  }
+  // Wheels 4.1 cm apart: yaw rate = 2 * 20 * 2.8 mm/s / 0.041 m = 2.73 rad/s.
+  EXPECT_NEAR(turned / 2.0, 2 * 20 * 0.0028 / 0.041, 0.05 * 2.73);
+  EXPECT_LT((r.basePose().position - start).head<2>().norm(), 0.005) << "on the spot";
+}
+
+TEST(TreelsFast, AccelerationIsTractionLimitedAndTorqueIsRead) {
+  World w(fastWorld());
+  Robot& r = w.addRobot(loadLevel("fast"), {0, 0, 0}, "sbot_0");
+  runFor(w, 0.5);
+  r.setSpeed(70, 70);
+  w.step();
+  // mu 1 in 1/50 g: at most 0.196 m/s^2, so one 100 ms step gains at most ~2 cm/s of the 19.6.
+  EXPECT_LT(r.linearVelocity().head<2>().norm(), 0.025);
+  EXPECT_GT(r.linearVelocity().head<2>().norm(), 0.010);
+  int tl, tr;
+  r.getTrackTorque(&tl, &tr);
+  EXPECT_GT(tl, 5) << "the drive's force shows as track torque while accelerating";
+  EXPECT_GT(tr, 5);
+  EXPECT_NEAR(tl, tr, 10) << "straight: the yaw motor only holds small disturbances";
+}
+
+TEST(TreelsFast, PassiveFastRobotHoldsBelowItsScaledBackDriveForce) {
+  World w(fastWorld());
+  const RobotDescription& d = loadLevel("fast");
+  Robot& r = w.addRobot(d, {0, 0, 0}, "sbot_0");
+  r.setTracksPassive(true);
+  runFor(w, 0.5);
+  auto pulled = [&](double force) {
+    const double x0 = r.basePose().position.x();
+    for (int i = 0; i < 20; ++i) {
+      const Vec3 p = r.baseBody() ? r.basePose().position : Vec3::Zero();
+      dBodyAddForceAtPos(r.baseBody(), force, 0, 0, p.x(), p.y(), p.z());
+      w.step();
+    }
+    return r.basePose().position.x() - x0;
+  };
+  EXPECT_LT(pulled(0.7 * d.treels.backdrive_force), 0.002);
+  EXPECT_GT(pulled(2.0 * d.treels.backdrive_force), 0.01);
+}
+
 }  // namespace
 }  // namespace sbot::test

@@ -133,6 +133,13 @@ class Robot {
   };
 
   void build(const Pose& base_pose);
+  /// Destroys every ODE object this robot owns (bodies, geoms, its space, hinges, loop joints, the
+  /// body drive) and empties the bookkeeping: ~Robot and switchDescription.
+  void destroyModel();
+  void buildBodyDrive();
+  void applyBodyDrive(const TrackCommand& cmd);
+  /// Track surface speed [m/s] the body drive sees: forward speed -/+ yaw rate * width / 2.
+  double bodyDriveTrackSpeed(int side) const;
   void addReflectedRotorInertia(const std::vector<int>& track);
   void addLoopJoints(const std::map<std::string, Pose>& world_T_link,
                      const std::map<std::string, std::pair<int, Pose>>& link_group);
@@ -162,6 +169,17 @@ class Robot {
   double req_left_ = 0, req_right_ = 0;  ///< requested track speeds [m/s]
   double turret_target_ = 0;             ///< [rad]
   bool passive_ = false;
+
+  // Body drive (sidecar treels.drive: body; the Fast level). In 1/50 g a 1/20-mass robot's wheel
+  // contacts carry ~10 mN, too little for ODE's wheel contacts at 100 ms steps (the robot hops and
+  // spins its wheels in place), so the tracks act on the chassis directly: a linear motor holds the
+  // forward speed (and no side slip) and an angular motor the yaw rate of an ideal differential
+  // drive, each force-limited by the motors and by traction (mu * weight * up.z).
+  dJointID drive_linear_ = nullptr;   ///< LMotor, axes chassis x and y
+  dJointID drive_angular_ = nullptr;  ///< AMotor, axis chassis z
+  dJointFeedback drive_linear_fb_{}, drive_angular_fb_{};
+  double drive_track_width_ = 0;      ///< [m] between the left and right driven wheels
+  double drive_torque_[2] = {0, 0};   ///< [N m] per track (left, right), last step
 };
 
 }  // namespace sbot

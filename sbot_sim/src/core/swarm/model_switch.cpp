@@ -94,6 +94,8 @@ void Robot::switchDescription(const RobotDescription& d) {
   std::set<dJointID> own;
   for (const auto& h : hinges_) own.insert(h.id);
   for (dJointID j : loop_joints_) own.insert(j);
+  for (dJointID j : {drive_linear_, drive_angular_})
+    if (j) own.insert(j);
   std::vector<ExternalJoint> externals;
   std::set<dJointID> seen;
   const auto& conns = world_.connections().list();
@@ -138,22 +140,7 @@ void Robot::switchDescription(const RobotDescription& d) {
   for (auto& e : externals) dJointAttach(e.joint, nullptr, nullptr);  // limbo while rebuilding
 
   // ---- 2. tear the old model down (as ~Robot, without touching other joints) ----------------------
-  for (auto& h : hinges_) dJointDestroy(h.id);
-  for (dJointID j : loop_joints_) dJointDestroy(j);
-  for (dGeomID g : geoms_) dGeomDestroy(g);
-  if (space_) dSpaceDestroy(space_);
-  for (dBodyID b : bodies_) dBodyDestroy(b);
-  bodies_.clear();
-  geoms_.clear();
-  geom_infos_.clear();
-  space_ = nullptr;
-  hinges_.clear();
-  loop_joints_.clear();
-  hinge_index_.clear();
-  link_index_.clear();
-  left_hinges_.clear();
-  right_hinges_.clear();
-  turret_hinge_ = -1;
+  destroyModel();
 
   // ---- 3. build the new one at the zero configuration -----------------------------------------------
   description_ = &d;
