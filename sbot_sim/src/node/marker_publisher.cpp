@@ -8,6 +8,8 @@
 
 #include "sbot_sim/core/terrain.h"
 
+#include "ros_conversions.h"
+
 namespace sbot_node {
 
 namespace {
@@ -17,24 +19,6 @@ constexpr double kTerrainRefresh = 5.0;
 /// The height map is drawn with at most this many cells per side.
 constexpr int kMaxHeightMapCells = 100;
 constexpr double kTrailWidth = 0.008;  // [m]
-
-geometry_msgs::Point toPoint(const sbot::Vec3& v) {
-  geometry_msgs::Point p;
-  p.x = v.x();
-  p.y = v.y();
-  p.z = v.z();
-  return p;
-}
-
-geometry_msgs::Pose toPose(const sbot::Pose& pose) {
-  geometry_msgs::Pose p;
-  p.position = toPoint(pose.position);
-  p.orientation.x = pose.orientation.x();
-  p.orientation.y = pose.orientation.y();
-  p.orientation.z = pose.orientation.z();
-  p.orientation.w = pose.orientation.w();
-  return p;
-}
 
 std_msgs::ColorRGBA rgba(double r, double g, double b, double a = 1.0) {
   std_msgs::ColorRGBA c;

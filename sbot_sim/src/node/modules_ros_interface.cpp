@@ -20,6 +20,8 @@
 #include <visualization_msgs/MarkerArray.h>
 #include <yaml-cpp/yaml.h>
 
+#include "ros_conversions.h"
+
 namespace sbot_node {
 
 namespace sn = sbot::sensors;
@@ -433,13 +435,6 @@ void RobotModulesRos::publishMarkers(const ros::Time& stamp) {
     m.lifetime = ros::Duration(1.0);
     return m;
   };
-  auto point = [](const sbot::Vec3& v) {
-    geometry_msgs::Point p;
-    p.x = v.x();
-    p.y = v.y();
-    p.z = v.z();
-    return p;
-  };
   if (suite_->available(sn::SensorChannel::Proximity) && suite_->proximity()) {
     const auto all = suite_->getAllProximitySensors();
     const auto& resp = suite_->proximity()->response();
@@ -451,8 +446,8 @@ void RobotModulesRos::publishMarkers(const ros::Time& stamp) {
       if (!robot_->hasLink(link)) continue;
       const sbot::Pose p = robot_->linkPose(link);
       const double d = all[k] == 0 ? range_max : std::min(range_max, resp.distance(all[k]));
-      rays.points.push_back(point(p.position));
-      rays.points.push_back(point(p.position + p.orientation * sbot::Vec3(d, 0, 0)));
+      rays.points.push_back(toPoint(p.position));
+      rays.points.push_back(toPoint(p.position + p.orientation * sbot::Vec3(d, 0, 0)));
       std_msgs::ColorRGBA c;
       const double level = std::min(1.0, std::log1p(static_cast<double>(all[k])) / std::log1p(8191.0));
       c.r = static_cast<float>(level);
@@ -469,7 +464,7 @@ void RobotModulesRos::publishMarkers(const ros::Time& stamp) {
     const std::string link = "light_" + std::to_string(k);
     if (!robot_->hasLink(link)) continue;
     visualization_msgs::Marker led = base("leds", k, visualization_msgs::Marker::SPHERE);
-    led.pose.position = point(robot_->linkPose(link).position);
+    led.pose.position = toPoint(robot_->linkPose(link).position);
     led.scale.x = led.scale.y = led.scale.z = 0.012;
     const auto& gp = ring.groups[k];
     const bool lit = ring.isLit(k, env_->time());
@@ -482,7 +477,7 @@ void RobotModulesRos::publishMarkers(const ros::Time& stamp) {
   int id = 0;
   for (const sn::Lamp& l : env_->lamps()) {
     visualization_msgs::Marker lamp = base("lamps", id++, visualization_msgs::Marker::SPHERE);
-    lamp.pose.position = point(l.position);
+    lamp.pose.position = toPoint(l.position);
     lamp.scale.x = lamp.scale.y = lamp.scale.z = 0.05;
     lamp.color.r = static_cast<float>(l.colour.x());
     lamp.color.g = static_cast<float>(l.colour.y());

@@ -10,6 +10,8 @@
 #include <sbot_msgs/TurretState.h>
 #include <sensor_msgs/JointState.h>
 
+#include "ros_conversions.h"
+
 namespace sbot_node {
 
 namespace {
@@ -18,31 +20,6 @@ namespace {
 constexpr const char* kTrackJoint = "left_wheel_joint";
 constexpr double kFallbackTrackSeparation = 0.082;  // [m] seed Table 2.2, centre wheels separation
 constexpr std::uint32_t kStateQueue = 100;
-
-geometry_msgs::Point toPoint(const sbot::Vec3& v) {
-  geometry_msgs::Point p;
-  p.x = v.x();
-  p.y = v.y();
-  p.z = v.z();
-  return p;
-}
-
-geometry_msgs::Vector3 toVector3(const sbot::Vec3& v) {
-  geometry_msgs::Vector3 p;
-  p.x = v.x();
-  p.y = v.y();
-  p.z = v.z();
-  return p;
-}
-
-geometry_msgs::Quaternion toQuaternion(const sbot::Quat& q) {
-  geometry_msgs::Quaternion m;
-  m.x = q.x();
-  m.y = q.y();
-  m.z = q.z();
-  m.w = q.w();
-  return m;
-}
 
 int clampInt(long v, int lo, int hi) { return static_cast<int>(std::min<long>(hi, std::max<long>(lo, v))); }
 

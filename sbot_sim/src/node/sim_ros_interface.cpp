@@ -1,5 +1,7 @@
 #include "sim_ros_interface.h"
 
+#include "robot_lookup.h"
+
 #include "sbot_sim/core/effects/effects_file.h"
 
 #include <cmath>
@@ -126,7 +128,7 @@ bool SimRosInterface::init() {
   char duration[64] = "unlimited";
   if (end_time_ > 0) std::snprintf(duration, sizeof(duration), "%g s", end_time_);
   ROS_INFO("simulator: scenario %s: %zu robots (%s), step %g s, seed %llu, duration %s%s",
-           scenario_.source.c_str(), world_->robotCount(), robotList().c_str(), dt,
+           scenario_.source.c_str(), world_->robotCount(), robotSummary(world_.get()).c_str(), dt,
            static_cast<unsigned long long>(world_->config().seed), duration,
            paused_ ? "; starting paused (call /sim/unpause or /sim/step)" : "");
   if (params_.publish_rate * dt > 1.0 + 1e-9)
@@ -268,21 +270,6 @@ void SimRosInterface::logSummary(const std::string& reason) const {
   }
 }
 
-std::string SimRosInterface::robotList() const {
-  std::vector<std::string> names;
-  for (const auto& r : robots_) names.push_back(r->name());
-  if (names.empty()) return "none";
-  bool canonical = names.size() > 1;
-  for (std::size_t i = 0; canonical && i < names.size(); ++i)
-    canonical = names[i] == "sbot_" + std::to_string(i);
-  if (canonical) return names.front() + ".." + names.back();
-  std::ostringstream out;
-  const std::size_t shown = std::min<std::size_t>(names.size(), 10);
-  for (std::size_t i = 0; i < shown; ++i) out << (i ? ", " : "") << names[i];
-  if (shown < names.size()) out << ", ... (" << names.size() << " robots)";
-  return out.str();
-}
-
 // ---- services ---------------------------------------------------------------------------------
 
 bool SimRosInterface::onPause(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
@@ -378,15 +365,8 @@ bool SimRosInterface::onStep(sbot_msgs::Step::Request& req, sbot_msgs::Step::Res
 
 bool SimRosInterface::onSetPose(sbot_msgs::SetPose::Request& req, sbot_msgs::SetPose::Response& res) {
   res.success = false;
-  if (!world_) {
-    res.message = "no world (a reset failed)";
-    return true;
-  }
-  sbot::Robot* robot = world_->findRobot(req.robot);
-  if (!robot) {
-    res.message = "unknown robot '" + req.robot + "' (robots: " + robotList() + ")";
-    return true;
-  }
+  sbot::Robot* robot = lookupRobot(world_.get(), req.robot, res.message);
+  if (!robot) return true;
   const std::pair<const char*, double> fields[] = {
       {"x", req.x}, {"y", req.y}, {"z", req.z}, {"yaw", req.yaw}};
   for (const auto& f : fields) {

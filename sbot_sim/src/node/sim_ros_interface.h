@@ -64,7 +64,6 @@ class SimRosInterface {
   bool durationReached() const;
   void resetPacing();
   double wallUntilNextStep();
-  std::string robotList() const;
   void logSummary(const std::string& reason) const;
 
   bool onPause(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);

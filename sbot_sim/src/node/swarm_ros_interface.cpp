@@ -1,5 +1,7 @@
 #include "swarm_ros_interface.h"
 
+#include "robot_lookup.h"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -134,16 +136,6 @@ bool SwarmRosInterface::knownLevel(const std::string& level) {
   return std::find(levels.begin(), levels.end(), level) != levels.end();
 }
 
-std::string SwarmRosInterface::robotNames() const {
-  if (!world_) return "none";
-  std::ostringstream out;
-  const auto robots = world_->robots();
-  for (std::size_t i = 0; i < robots.size() && i < 10; ++i) out << (i ? ", " : "") << robots[i]->name();
-  if (robots.size() > 10) out << ", ... (" << robots.size() << " robots)";
-  if (robots.empty()) out << "none";
-  return out.str();
-}
-
 std::string SwarmRosInterface::sensorSummary(const sbot::RobotDescription& d) {
   std::ostringstream s;
   s << "ir:" << d.extraOr("ir_model", "?");
@@ -159,15 +151,8 @@ std::string SwarmRosInterface::sensorSummary(const sbot::RobotDescription& d) {
 bool SwarmRosInterface::onSetModelLevel(sbot_msgs::SetModelLevel::Request& req,
                                         sbot_msgs::SetModelLevel::Response& res) {
   res.success = false;
-  if (!world_) {
-    res.message = "no world (a reset failed)";
-    return true;
-  }
-  sbot::Robot* robot = world_->findRobot(req.robot);
-  if (!robot) {
-    res.message = "unknown robot '" + req.robot + "' (robots: " + robotNames() + ")";
-    return true;
-  }
+  sbot::Robot* robot = lookupRobot(world_.get(), req.robot, res.message);
+  if (!robot) return true;
   if (!knownLevel(req.level)) {
     res.message = "unknown model level '" + req.level + "' (levels: fast, simple, basic, medium, detailed)";
     return true;
@@ -243,15 +228,8 @@ bool SwarmRosInterface::onSpawn(sbot_msgs::Spawn::Request& req, sbot_msgs::Spawn
 
 bool SwarmRosInterface::onDelete(sbot_msgs::Delete::Request& req, sbot_msgs::Delete::Response& res) {
   res.success = false;
-  if (!world_) {
-    res.message = "no world (a reset failed)";
-    return true;
-  }
-  sbot::Robot* robot = world_->findRobot(req.name);
-  if (!robot) {
-    res.message = "unknown robot '" + req.name + "' (robots: " + robotNames() + ")";
-    return true;
-  }
+  sbot::Robot* robot = lookupRobot(world_.get(), req.name, res.message);
+  if (!robot) return true;
   for (auto& hook : before_delete) hook(*robot);
   // Its interface stays (unbound: silent, commands ignored), so /sim/reset or a /sim/spawn of the
   // same name brings the robot back on the same topics.

@@ -64,7 +64,6 @@ class SwarmRosInterface {
   bool onSpawn(sbot_msgs::Spawn::Request& req, sbot_msgs::Spawn::Response& res);
   bool onDelete(sbot_msgs::Delete::Request& req, sbot_msgs::Delete::Response& res);
   void publish(double sim_time);
-  std::string robotNames() const;
   static bool knownLevel(const std::string& level);
 
   ros::NodeHandle nh_;
