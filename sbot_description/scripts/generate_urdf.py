@@ -363,7 +363,7 @@ def build(level, p):
     rb.joint("gripper_tip_joint", "fixed", "gripper", "gripper_tip", (g["grip_point_m"], 0, 0))
     if g["type"] == "jaws":
         jw = g["jaws"]
-        torque = jw["force_N"] * jw["lever_m"]
+        torque = min(jw["force_N"] * jw["lever_m"], jw.get("servo_torque_max_Nm", float("inf")))
         size = [jw["length_m"], jw["width_m"], jw["thickness_m"]]
         for name, sz, ax in (("gripper_jaw_upper", 1.0, (0, -1, 0)),
                              ("gripper_jaw_lower", -1.0, (0, 1, 0))):

@@ -219,7 +219,7 @@ def value_errors(u, sc, p, level):
             lim = u.limit(j)
             chk(j + " upper", lim["upper"], jw["upper_rad"])
             chk(j + " lower", lim["lower"], jw["lower_rad"])
-            chk(j + " effort", lim["effort"], jw["force_N"] * jw["lever_m"])
+            chk(j + " effort", lim["effort"], min(jw["force_N"] * jw["lever_m"], jw.get("servo_torque_max_Nm", float("inf"))))
             chk(j + " velocity", lim["velocity"], jw["speed_rads"])
     # side arm servos
     sa = p.get("side_arm")

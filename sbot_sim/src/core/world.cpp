@@ -44,7 +44,7 @@ World::World(const WorldConfig& config) : config_(config) {
 
   world_ = dWorldCreate();
   dWorldSetGravity(world_, 0, 0, -config_.gravity);
-  dWorldSetQuickStepNumIterations(world_, config_.solver_iterations);
+  updateSolverIterations();
   dWorldSetQuickStepW(world_, config_.solver_sor);
   dWorldSetContactSurfaceLayer(world_, 0.0005);
   dWorldSetContactMaxCorrectingVel(world_, 0.5);
@@ -128,7 +128,23 @@ Robot& World::addRobot(const RobotDescription& description, const Pose2D& pose, 
 Robot& World::addRobotAt(const RobotDescription& description, const Pose& pose, const std::string& name) {
   if (findRobot(name)) throw ConfigError("<world>", "robots", "duplicate robot name '" + name + "'");
   robots_.push_back(std::make_unique<Robot>(*this, description, name, next_index_++, pose));
+  updateSolverIterations();
   return *robots_.back();
+}
+
+Robot& World::switchLevel(const std::string& name, const RobotDescription& description) {
+  Robot& r = robot(name);
+  r.switchDescription(description);
+  updateSolverIterations();
+  return r;
+}
+
+void World::updateSolverIterations() {
+  int n = config_.solver_iterations;
+  if (config_.level_iterations)
+    for (const auto& r : robots_) n = std::max(n, r->description().solver_iterations);
+  if (n != solver_iterations_) dWorldSetQuickStepNumIterations(world_, n);
+  solver_iterations_ = n;
 }
 
 void World::removeRobot(const std::string& name) {
@@ -136,6 +152,7 @@ void World::removeRobot(const std::string& name) {
   if (it == robots_.end()) throw UnknownName("unknown robot '" + name + "'");
   connections_->removeRobot(name);
   robots_.erase(it);
+  updateSolverIterations();
 }
 
 Robot* World::findRobot(const std::string& name) {

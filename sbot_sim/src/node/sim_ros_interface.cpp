@@ -127,9 +127,9 @@ bool SimRosInterface::init() {
   const double dt = world_->config().step;
   char duration[64] = "unlimited";
   if (end_time_ > 0) std::snprintf(duration, sizeof(duration), "%g s", end_time_);
-  ROS_INFO("simulator: scenario %s: %zu robots (%s), step %g s, seed %llu, duration %s%s",
+  ROS_INFO("simulator: scenario %s: %zu robots (%s), step %g s, %d solver iterations, seed %llu, duration %s%s",
            scenario_.source.c_str(), world_->robotCount(), robotSummary(world_.get()).c_str(), dt,
-           static_cast<unsigned long long>(world_->config().seed), duration,
+           world_->solverIterations(), static_cast<unsigned long long>(world_->config().seed), duration,
            paused_ ? "; starting paused (call /sim/unpause or /sim/step)" : "");
   if (params_.publish_rate * dt > 1.0 + 1e-9)
     ROS_WARN("simulator: ~publish_rate %g Hz exceeds the step rate %g Hz: publishing every step",

@@ -121,9 +121,11 @@ TEST(ModelSwitch, LevelsRoundTrip) {
   }
   EXPECT_EQ(r.bodies().size(), bodies);
   EXPECT_EQ(r.geomCount(), geoms);
-  // Standing still through six switches: it has not moved.
+  // Standing still through six switches: it has not moved. (Standing Basic/Medium robots turn by
+  // ~0.6 / 1.3 deg/s from quickstep's unconverged turret hinge, README "Known flaw: yaw drift":
+  // 0.6 s of each is ~1.2 deg = 0.02 rad of the allowance.)
   EXPECT_LT((r.basePose().position - p0.position).norm(), 0.005);
-  EXPECT_LT(r.basePose().orientation.angularDistance(p0.orientation), 0.02);
+  EXPECT_LT(r.basePose().orientation.angularDistance(p0.orientation), 0.03);
 }
 
 TEST(ModelSwitch, WideTurretAngleSurvives) {
@@ -183,6 +185,29 @@ TEST(ModelSwitch, ConnectionsSurviveASwitch) {
   const swarm::SwarmGraph g = swarm::computeSwarmGraph(w);
   EXPECT_EQ(g.connection(g.indexOf("sbot_1"), g.indexOf("sbot_0")), swarm::kFrontGripper);
   EXPECT_EQ(g.components, 1u);
+}
+
+TEST(ModelSwitch, SolverIterationsFollowTheLevelsInTheWorld) {
+  // Detailed needs 40 quickstep iterations (sidecar); the world runs at the most any robot needs.
+  WorldConfig c;
+  c.solver_iterations = 20;
+  World w(c);
+  EXPECT_EQ(w.solverIterations(), 20);
+  w.addRobot(loadLevel("basic"), {0, 0, 0}, "a");
+  EXPECT_EQ(w.solverIterations(), 20);
+  w.addRobot(loadLevel("basic"), {1, 0, 0}, "b");
+  w.switchLevel("b", loadLevel("detailed"));
+  EXPECT_EQ(w.solverIterations(), loadLevel("detailed").solver_iterations);
+  EXPECT_GT(w.solverIterations(), 20);
+  w.switchLevel("b", loadLevel("medium"));
+  EXPECT_EQ(w.solverIterations(), 20);
+  w.switchLevel("a", loadLevel("detailed"));
+  w.removeRobot("a");
+  EXPECT_EQ(w.solverIterations(), 20);
+  c.level_iterations = false;  // solver studies pin the number
+  World pinned(c);
+  pinned.addRobot(loadLevel("detailed"), {0, 0, 0}, "d");
+  EXPECT_EQ(pinned.solverIterations(), 20);
 }
 
 }  // namespace

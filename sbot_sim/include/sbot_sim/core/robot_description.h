@@ -80,6 +80,9 @@ struct RobotDescription {
   TurretSemantics turret;
   double recommended_step = 0.01;          ///< [s]
   double gravity = 9.81;                   ///< [m/s^2] the level's world gravity (Fast: reduced)
+  /// Quickstep iterations this level needs to behave as validated (sidecar extra solver_iterations;
+  /// 0 = no requirement). A World raises its iterations to the largest need of its robots.
+  int solver_iterations = 0;
   std::map<std::string, std::string> extra;///< sidecar `extra` scalars (sensor models, ...), as text
   YAML::Node sidecar;                      ///< the whole sidecar, for modules with structured entries
 

@@ -38,15 +38,13 @@ class World {
   void removeRobot(const std::string& name);
   /// Dynamic model switching (seed 2.1.3): rebuild robot `name` from `description` in place, keeping
   /// its state and connections (Robot::switchDescription). Throws UnknownName / ConfigError.
-  Robot& switchLevel(const std::string& name, const RobotDescription& description) {
-    Robot& r = robot(name);
-    r.switchDescription(description);
-    return r;
-  }
+  Robot& switchLevel(const std::string& name, const RobotDescription& description);
   Robot& robot(const std::string& name);            ///< throws UnknownName
   Robot* findRobot(const std::string& name);        ///< nullptr if absent
   std::vector<Robot*> robots();
   std::size_t robotCount() const { return robots_.size(); }
+  /// Quickstep iterations in use: the config's, raised to the robots' levels' needs.
+  int solverIterations() const { return solver_iterations_; }
 
   /// Advance one fixed step: effects' command hooks, motors, collisions, integration, feedback.
   void step();
@@ -91,6 +89,8 @@ class World {
   /// One ray geom (in no space) reused by castRay/terrainHeight: creating and destroying a geom per
   /// ray cost ~10 % of a sensor-reading Medium step. Makes a World unsafe to query from two threads.
   mutable dGeomID query_ray_ = nullptr;
+  int solver_iterations_ = 0;
+  void updateSolverIterations();  ///< after a robot came, went or changed level
   dGeomID queryRay(double length) const;  ///< query_ray_ with this length
   dJointGroupID contacts_ = nullptr;
   std::vector<dGeomID> static_geoms_;

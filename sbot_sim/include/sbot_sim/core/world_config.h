@@ -63,6 +63,9 @@ struct WorldConfig {
   double step = 0.01;          ///< fixed integration step [s]
   double gravity = 9.81;       ///< [m/s^2], pointing -z
   int solver_iterations = 20;  ///< ODE quickstep iterations (ODE default; see README benchmark)
+  /// Raise the iterations to what the robots' levels need (RobotDescription::solver_iterations,
+  /// Detailed: 40) while such a robot is in the world. Off only to study the solver itself.
+  bool level_iterations = true;
   double solver_sor = 1.3;     ///< ODE quickstep over-relaxation
   std::uint64_t seed = 1;      ///< root of every random stream
   ContactConfig contact;
