@@ -163,7 +163,11 @@ void parseTerrain(const YAML::Node& n, TerrainConfig& t, const std::string& file
 void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
   Fields f(n, "world", file);
   // lamps / ambient_light are read by the simulator node (sensed environment, not physics).
-  f.allowOnly({"step", "gravity", "solver_iterations", "solver_sor", "contact", "terrain", "lamps", "ambient_light"});
+  f.allowOnly({"step", "gravity", "solver", "solver_iterations", "solver_sor", "contact", "terrain", "lamps",
+               "ambient_light"});
+  w.solver = f.text("solver", w.solver);
+  if (w.solver != "quickstep" && w.solver != "exact")
+    throw ConfigError(file, f.path("solver"), "expected 'quickstep' or 'exact', found '" + w.solver + "'");
   w.step = f.positive("step", w.step);
   w.gravity = f.number("gravity", w.gravity);
   w.solver_iterations = static_cast<int>(f.positive("solver_iterations", w.solver_iterations));

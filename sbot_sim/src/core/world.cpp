@@ -42,6 +42,9 @@ World::World(const WorldConfig& config) : config_(config) {
   initOdeOnce();
   if (!(config_.step > 0)) throw ConfigError("<world>", "step", "must be > 0");
 
+  if (config_.solver != "quickstep" && config_.solver != "exact")
+    throw ConfigError("<world>", "solver", "expected 'quickstep' or 'exact', found '" + config_.solver + "'");
+  exact_solver_ = config_.solver == "exact";
   world_ = dWorldCreate();
   dWorldSetGravity(world_, 0, 0, -config_.gravity);
   updateSolverIterations();
@@ -185,7 +188,10 @@ void World::step() {
   // count makes every run of a scenario bit-identical whatever other worlds did in this process.
   // (Worlds in parallel threads would share that generator: run parallel simulations as processes.)
   dRandSetSeed(static_cast<unsigned long>(stableHash(config_.seed, std::to_string(steps_))));
-  dWorldQuickStep(world_, dt);
+  if (exact_solver_)
+    dWorldStep(world_, dt);
+  else
+    dWorldQuickStep(world_, dt);
   dJointGroupEmpty(contacts_);
   for (auto& r : robots_) r->readFeedback();
   time_ += dt;

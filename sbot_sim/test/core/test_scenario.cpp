@@ -48,6 +48,8 @@ TEST(Scenario, RobotCountOverride) {
 TEST(Scenario, ErrorsNameFileAndField) {
   EXPECT_NE(errorOf("world: {step: -1}").find("bad.yaml: field 'world.step'"), std::string::npos);
   EXPECT_NE(errorOf("world: {step: fast}").find("'world.step': expected a number"), std::string::npos);
+  EXPECT_NE(errorOf("world: {solver: magic}").find("'world.solver': expected 'quickstep' or 'exact', found 'magic'"),
+            std::string::npos);
   EXPECT_NE(errorOf("robots: [{level: huge}]").find("'robots[0].level': unknown model level 'huge'"),
             std::string::npos);
   EXPECT_NE(errorOf("robots: [{pose: {x: 1, z: 2}}]").find("'robots[0].pose.z': unknown field"), std::string::npos);

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "sbot_sim/core/errors.h"
 #include "sim_fixture.h"
 
 namespace sbot::test {
@@ -176,6 +177,29 @@ double breakawayForce() {
 
 TEST(Treels, PassiveRobotBreaksAwayAtTheSeeds1_2Newton) {
   EXPECT_NEAR(breakawayForce(), 1.2, 0.15) << "pull force [N] at which a passive s-bot starts rolling";
+}
+
+// ---- world.solver: exact (dWorldStep) --------------------------------------------------------
+
+/// Heading change [deg] of a robot of `level` driving setSpeed(units, units) for 10 s.
+double headingChange(const std::string& level, const std::string& solver, int units) {
+  WorldConfig c = flatWorld();
+  c.solver = solver;
+  World w(c);
+  Robot& r = w.addRobot(loadLevel(level), {0, 0, 0}, "sbot_0");
+  r.setSpeed(units, units);
+  const double yaw0 = r.basePose().yaw();
+  runFor(w, 10.0);
+  return wrapAngle(r.basePose().yaw() - yaw0) * 180 / M_PI;
+}
+
+TEST(TreelsExactSolver, SymmetricCommandsDriveStraight) {
+  // Quickstep at 20 iterations turns Basic/Medium ~1 deg/s (README, "Known flaw: yaw drift").
+  for (const std::string level : {"simple", "basic", "medium"}) {
+    EXPECT_LT(std::abs(headingChange(level, "exact", 60)), 0.5) << level << " driving";
+    EXPECT_LT(std::abs(headingChange(level, "exact", 0)), 0.2) << level << " standing";
+  }
+  EXPECT_THROW(headingChange("simple", "fancy", 10), ConfigError);
 }
 
 // ---- Fast level: body drive in 1/50 g at 100 ms steps (sidecar treels.drive: body) -------------

@@ -90,6 +90,7 @@ class World {
   /// ray cost ~10 % of a sensor-reading Medium step. Makes a World unsafe to query from two threads.
   mutable dGeomID query_ray_ = nullptr;
   int solver_iterations_ = 0;
+  bool exact_solver_ = false;     ///< config_.solver == "exact"
   void updateSolverIterations();  ///< after a robot came, went or changed level
   dGeomID queryRay(double length) const;  ///< query_ray_ with this length
   dJointGroupID contacts_ = nullptr;
