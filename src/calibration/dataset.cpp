@@ -416,11 +416,11 @@ Dataset loadDataset(const std::string& path_in) {
   // obstacles, lamps and ambient light.
   if (const YAML::Node w = root["world"]) {
     if (!w.IsMap()) fail(f, w, "world", "expected a mapping");
-    allowOnly(w, f, "world", {"step", "gravity", "solver_iterations", "solver_sor", "contact", "terrain",
+    allowOnly(w, f, "world", {"step", "gravity", "solver", "solver_iterations", "solver_sor", "contact", "terrain",
                               "obstacles", "lamps", "ambient_light"});
     YAML::Node scenario;
     YAML::Node sw;
-    for (const char* k : {"step", "gravity", "solver_iterations", "solver_sor", "contact", "terrain"})
+    for (const char* k : {"step", "gravity", "solver", "solver_iterations", "solver_sor", "contact", "terrain"})
       if (w[k]) sw[k] = w[k];
     scenario["world"] = sw;
     try {
@@ -627,6 +627,7 @@ void writeDataset(const Dataset& ds, const std::string& dir) {
   if (!ds.description.empty()) e << YAML::Key << "description" << YAML::Value << ds.description;
   e << YAML::Key << "robot" << YAML::Value << ds.robot;
   e << YAML::Key << "world" << YAML::Value << YAML::BeginMap;
+  if (ds.world.solver != "quickstep") e << YAML::Key << "solver" << YAML::Value << ds.world.solver;
   e << YAML::Key << "terrain" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "type" << YAML::Value
     << "plane" << YAML::EndMap;
   if (!ds.world.terrain.boxes.empty()) {

@@ -111,6 +111,7 @@ Dataset generateDataset(const GeneratorOptions& opt, WorkerPool& pool, Generated
   Dataset ds;
   ds.name = opt.name;
   ds.robot = opt.level;
+  ds.world.solver = opt.solver;
   ds.noise = opt.noise;
   ds.align_segment = opt.align_segment;
   ds.description = "synthetic dataset (sbot_calibrate generate, seed " + std::to_string(opt.seed) + ")";

@@ -17,6 +17,7 @@ namespace sbot::calib {
 struct GeneratorOptions {
   std::string name = "synthetic";
   std::string level = "simple";
+  std::string solver = "quickstep";        ///< the simulated world's stepper (world.solver)
   std::uint64_t seed = 1;
   std::vector<EffectConfig> hidden;        ///< effects switched on in the "real" robot
   double tilt_deg = 0;                     ///< hidden floor tilt [deg] (not in the library)

@@ -125,10 +125,10 @@ void usage() {
                "  compare  DATASET [--effects FILE] [--out DIR] [--no-plots]\n"
                "  diagnose DATASET [--effects BASE] [--folds K] [--threshold DBIC] [--candidates a,b] [--write-effects FILE]\n"
                "  fit      DATASET --effect NAME [--effect NAME2] [--effects BASE] --out FILE\n"
-               "  generate --out DIR [--level simple] [--seed N] [--hidden FILE] [--hide name:p=v+name2:p=v]\n"
+               "  generate --out DIR [--level simple] [--solver quickstep|exact] [--seed N] [--hidden FILE] [--hide name:p=v+name2:p=v]\n"
                "           [--tilt DEG] [--duration S] [--families straight,spin,arc,square,steps] [--repeat N]\n"
                "           [--max-runs N] [--name NAME] [--torque] [--no-tilt] [--no-speed]\n"
-               "  sweep    [--out FILE.md] [--seeds N] [--cases a,b] [--level L] [--duration S]\n"
+               "  sweep    [--out FILE.md] [--seeds N] [--cases a,b] [--level L] [--solver S] [--duration S]\n"
                "  effects  list the effects library\n"
                "common options: --jobs N (worker processes; default all cores), --quiet\n");
 }
@@ -281,6 +281,7 @@ int cmdGenerate(const Args& a) {
   if (!a.has("out")) throw std::invalid_argument("generate needs --out DIR");
   GeneratorOptions g;
   g.level = a.get("level", "simple");
+  g.solver = a.get("solver", "quickstep");
   g.seed = static_cast<std::uint64_t>(a.num("seed", 1));
   g.duration = a.num("duration", 8);
   g.tilt_deg = a.num("tilt", 0);

@@ -212,7 +212,7 @@ std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool) {
 std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions& opt, double seconds) {
   std::ostringstream md;
   md << "Sweep: " << opt.seeds << " seeds per case, level " << opt.gen.level << ", drive patterns of "
-     << opt.gen.duration << " s, " << opt.diag.folds << "-fold split by run, acceptance dBIC > "
+     << opt.gen.duration << " s, solver " << opt.gen.solver << ", " << opt.diag.folds << "-fold split by run, acceptance dBIC > "
      << opt.diag.bic_threshold << "; " << std::fixed << std::setprecision(0) << seconds << " s wall.\n\n";
   md << "| hidden | truth | right first | params +-10 % | held-out RMS -50 % | ends <= 1.2x floor | nothing accepted | "
         "structure flagged | both found | s/diagnose |\n|---|---|---|---|---|---|---|---|---|---|\n";
@@ -252,6 +252,7 @@ int runSweepCommand(const std::multimap<std::string, std::string>& opts, const s
   };
   SweepOptions o;
   o.gen.level = get("level", "simple");
+  o.gen.solver = get("solver", "quickstep");
   o.gen.duration = std::stod(get("duration", "8"));
   o.gen.measure_torque = flags.count("torque") != 0;
   o.seeds = std::stoi(get("seeds", "10"));
