@@ -521,16 +521,10 @@ void Robot::applyCommands(double dt, const std::vector<EffectPtr>& effects) {
 }
 
 void Robot::applyBodyDrive(const TrackCommand& cmd) {
+  // (The wheel hinges stay as built: FMax 0, rolling freely.)
   const TreelsSemantics& tr = description_->treels;
-  for (int i : left_hinges_) dJointSetHingeParam(hinges_[i].id, dParamFMax, 0);  // wheels roll freely
-  for (int i : right_hinges_) dJointSetHingeParam(hinges_[i].id, dParamFMax, 0);
   // Traction: mu(track, ground) * weight, scaled by how upright the chassis is (no push when toppled).
-  double mass = 0;
-  for (dBodyID b : bodies_) {
-    dMass m;
-    dBodyGetMass(b, &m);
-    mass += m.mass;
-  }
+  const double mass = description_->totalMass();
   const Vec3 up = bodyPose(baseBody()).orientation * Vec3::UnitZ();
   // The wheels are passive supports (frictionless, like casters: friction at the wheel contacts
   // would tip the light robot over in every turn); the drive's grip is the track material's.
