@@ -1,5 +1,9 @@
 #include "sbot_sim/core/world.h"
 
+#include <atomic>
+#include <cstdarg>
+#include <cstdio>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -13,9 +17,23 @@
 namespace sbot {
 namespace {
 
+// ODE's informational messages (with the exact solver: "LCP internal error" whenever contacts are
+// redundant, up to every step) would flood the logs: print the first ten, then every 1000th.
+void odeMessage(int num, const char* msg, va_list ap) {
+  static std::atomic<long> count{0};
+  const long n = ++count;
+  if (n > 10 && n % 1000 != 0) return;
+  std::fprintf(stderr, "ODE message %d (%ld so far): ", num, n);
+  std::vfprintf(stderr, msg, ap);
+  std::fprintf(stderr, "\n");
+}
+
 void initOdeOnce() {
   static std::once_flag once;
-  std::call_once(once, [] { dInitODE2(0); });
+  std::call_once(once, [] {
+    dInitODE2(0);
+    dSetMessageHandler(&odeMessage);
+  });
   // Every thread that touches ODE needs its own collision scratch data (parallel simulations).
   dAllocateODEDataForThread(dAllocateMaskAll);
 }
