@@ -122,15 +122,17 @@ FitResult fitModel(const Dataset& ds, const ModelSpec& start, const std::vector<
         const ParamSpec& s = free[j].spec;
         std::vector<ModelSpec> scan;
         std::vector<double> vals;
-        for (double f : {0.25, 0.5, 0.75}) {
-          const double lo = std::isfinite(s.lower) ? s.lower : s.null_value - 10 * s.scale;
-          const double hi = std::isfinite(s.upper) ? s.upper : s.null_value + 10 * s.scale;
-          // Scan toward the bound farther from the current value.
-          const double far = (hi - theta[j] > theta[j] - lo) ? hi : lo;
-          std::vector<double> th = theta;
-          th[j] = theta[j] + f * (far - theta[j]);
-          vals.push_back(th[j]);
-          scan.push_back(modelAt(th));
+        // Scan toward both bounds: a saturation binds on one side only (torque_saturation's scale
+        // below 1), and which side is not knowable from a flat start.
+        const double lo = std::isfinite(s.lower) ? s.lower : s.null_value - 10 * s.scale;
+        const double hi = std::isfinite(s.upper) ? s.upper : s.null_value + 10 * s.scale;
+        for (double bound : {lo, hi}) {
+          for (double f : {0.25, 0.5, 0.75}) {
+            std::vector<double> th = theta;
+            th[j] = theta[j] + f * (bound - theta[j]);
+            vals.push_back(th[j]);
+            scan.push_back(modelAt(th));
+          }
         }
         const auto ev = batch(ds, scan, runs, opt.eval, pool);
         tick();
