@@ -115,10 +115,12 @@ FitResult fitModel(const Dataset& ds, const ModelSpec& start, const std::vector<
     J.resize(r0.size(), k);
     for (std::size_t j = 0; j < k; ++j) J.col(j) = (cols[j].stacked() - r0) / h[j];
 
-    // Flat start (e.g. a saturation that never binds at its null value): coarse scan once.
+    // Flat start (e.g. a saturation that never binds at its null value) or a one-sided parameter:
+    // coarse scan once.
     if (it == 0 && opt.scan_flat) {
       for (std::size_t j = 0; j < k; ++j) {
-        if (J.col(j).norm() * free[j].spec.scale > 1e-3 * std::max(1.0, std::sqrt(cost))) continue;
+        const bool flat = J.col(j).norm() * free[j].spec.scale <= 1e-3 * std::max(1.0, std::sqrt(cost));
+        if (!flat && !free[j].spec.one_sided) continue;
         const ParamSpec& s = free[j].spec;
         std::vector<ModelSpec> scan;
         std::vector<double> vals;

@@ -279,7 +279,7 @@ EffectInfo TorqueSaturationEffect::describe() {
           "acceleration, earlier stall, lower torque readings at the limit.",
           {"pose", "speed", "torque"},
           "pushing against a wall or a load, hard accelerations with torque logged",
-          {{"scale", "1", 1.0, 0.02, 2.0, 0.1, "available / nominal maximum torque"}}};
+          {{"scale", "1", 1.0, 0.02, 2.0, 0.1, "available / nominal maximum torque", /*one_sided=*/true}}};
 }
 
 void TorqueSaturationEffect::onCommand(const Robot&, TrackCommand& cmd, double) {

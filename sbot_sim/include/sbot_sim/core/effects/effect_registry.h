@@ -27,6 +27,9 @@ struct ParamSpec {
   double upper = std::numeric_limits<double>::infinity();
   double scale = 1;          ///< typical magnitude of a departure from null (fit step, damping)
   std::string description;
+  /// A saturation that binds on one side of null only (torque_saturation below 1): the local
+  /// gradient at null says nothing about the other side, so the fitter scans both first.
+  bool one_sided = false;
 };
 
 /// Static description of an effect kind.
