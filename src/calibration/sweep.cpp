@@ -181,7 +181,9 @@ std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool) {
           for (const auto& [key, tv] : o.truth) {
             auto it = o.estimate.find(key);
             const std::string pname = key.substr(key.find('.') + 1);
-            const double null = reg.info(e).findParam(pname)->null_value;
+            // specFor: open parameters (ir_reflectance's per-surface "<surface>") have a template spec.
+            const ParamSpec* spec = reg.info(e).specFor(pname);
+            const double null = spec ? spec->null_value : 0.0;
             within &= it != o.estimate.end() && std::abs(it->second - tv) <= 0.1 * std::abs(tv - null);
           }
           cs.params_within += within / n;
