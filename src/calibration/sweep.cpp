@@ -239,8 +239,14 @@ std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions&
     for (const auto& o : c.seeds) {
       std::string acc;
       for (const auto& a : o.accepted) acc += (acc.empty() ? "" : "+") + a;
-      md << "s" << o.seed << " {" << (acc.empty() ? "none" : acc) << "} " << std::setprecision(2) << o.rms_before
-         << "->" << o.rms_after << " (" << o.floor << ")" << (o.structure_flagged ? " F" : "") << "; ";
+      md << "s" << o.seed << " {" << (acc.empty() ? "none" : acc) << "} ";
+      // The hidden parameters as estimated (truth in the table above): what "params +-10 %" judged.
+      for (const auto& [key, truth_value] : o.truth) {
+        auto it = o.estimate.find(key);
+        if (it != o.estimate.end()) md << key << "=" << std::setprecision(4) << it->second << " ";
+      }
+      md << std::setprecision(2) << o.rms_before << "->" << o.rms_after << " (" << o.floor << ")"
+         << (o.structure_flagged ? " F" : "") << "; ";
     }
     md << "\n";
   }
