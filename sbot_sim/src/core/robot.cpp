@@ -199,6 +199,7 @@ void Robot::build(const Pose& base_pose) {
   for (const auto& jn : d.treels.left_joints) left_hinges_.push_back(hinge_index_.at(jn));
   for (const auto& jn : d.treels.right_joints) right_hinges_.push_back(hinge_index_.at(jn));
   if (!d.turret.joint.empty()) turret_hinge_ = hinge_index_.at(d.turret.joint);
+  measureTrackWidth();
   if (d.treels.drive == "body") {
     buildBodyDrive();
   } else {
@@ -208,19 +209,30 @@ void Robot::build(const Pose& base_pose) {
   addLoopJoints(world_T_link, link_group);
 }
 
-void Robot::buildBodyDrive() {
-  // Track width: lateral distance between the left and right driven wheels, in base_link.
+void Robot::measureTrackWidth() {
+  // Lateral offsets of the driven wheels' frames in base_link, averaged per side.
   const Pose base_inv = basePose().inverse();
   auto mean_y = [&](const std::vector<int>& side) {
     double sum = 0;
-    for (int i : side) sum += (base_inv * bodyPose(bodies_[hinges_[i].child_body])).position.y();
-    return sum / side.size();
+    int n = 0;
+    for (int i : side) {
+      const JointDescription* j = description_->findJoint(hinges_[i].name);
+      if (!j || !hasLink(j->child)) continue;
+      sum += (base_inv * linkPose(j->child)).position.y();
+      ++n;
+    }
+    return n ? sum / n : 0.0;
   };
-  drive_track_width_ = std::abs(mean_y(left_hinges_) - mean_y(right_hinges_));
-  if (!(drive_track_width_ > 1e-4))
+  const double w = std::abs(mean_y(left_hinges_) - mean_y(right_hinges_));
+  constexpr double kSeedTrackWidth = 0.082;  // [m] Table 2.2, centre wheels separation
+  track_width_ = w > 1e-3 ? w : kSeedTrackWidth;
+  wheels_apart_ = w > 1e-3;
+}
+
+void Robot::buildBodyDrive() {
+  if (!wheels_apart_)
     throw ConfigError(description_->sidecar_path, "treels.drive",
-                      "body drive needs left and right driven wheels apart, found a track width of " +
-                          std::to_string(drive_track_width_) + " m");
+                      "body drive needs left and right driven wheels apart; they are not in " + description_->urdf_path);
   dBodyID chassis = baseBody();
   drive_linear_ = dJointCreateLMotor(world_.odeWorld(), nullptr);
   dJointAttach(drive_linear_, chassis, nullptr);
@@ -244,7 +256,7 @@ double Robot::bodyDriveTrackSpeed(int side) const {
   const Quat q = bodyPose(chassis).orientation;
   const Vec3 v = q.inverse() * vec(dBodyGetLinearVel(chassis));
   const Vec3 w = q.inverse() * vec(dBodyGetAngularVel(chassis));
-  return v.x() + (side == 0 ? -1 : 1) * 0.5 * drive_track_width_ * w.z();
+  return v.x() + (side == 0 ? -1 : 1) * 0.5 * track_width_ * w.z();
 }
 
 void Robot::addLoopJoints(const std::map<std::string, Pose>& world_T_link,
@@ -533,14 +545,14 @@ void Robot::applyBodyDrive(const TrackCommand& cmd) {
   double v = 0, yaw_rate = 0, f_max = 0, t_max = 0;
   if (passive_) {
     f_max = std::min(traction, tr.backdrive_force);  // gear back-drive: the pull needed to move it
-    t_max = 0.5 * f_max * drive_track_width_;
+    t_max = 0.5 * f_max * track_width_;
   } else {
     const double f_left = std::max(0.0, cmd.max_torque_left) / tr.wheel_radius;  // [N] per track
     const double f_right = std::max(0.0, cmd.max_torque_right) / tr.wheel_radius;
     v = 0.5 * (cmd.left + cmd.right);
-    yaw_rate = (cmd.right - cmd.left) / drive_track_width_;
+    yaw_rate = (cmd.right - cmd.left) / track_width_;
     f_max = std::min(traction, f_left + f_right);
-    t_max = 0.5 * drive_track_width_ * std::min(traction, std::min(f_left, f_right) * 2);
+    t_max = 0.5 * track_width_ * std::min(traction, std::min(f_left, f_right) * 2);
   }
   dJointSetLMotorParam(drive_linear_, dParamVel, v);
   dJointSetLMotorParam(drive_linear_, dParamFMax, f_max);
@@ -568,8 +580,8 @@ void Robot::readFeedback() {
     const double forward = (q.inverse() * vec(drive_linear_fb_.f1)).x();
     const double yaw = (q.inverse() * vec(drive_angular_fb_.t1)).z();
     const double r = description_->treels.wheel_radius;
-    drive_torque_[0] = (0.5 * forward - yaw / drive_track_width_) * r;
-    drive_torque_[1] = (0.5 * forward + yaw / drive_track_width_) * r;
+    drive_torque_[0] = (0.5 * forward - yaw / track_width_) * r;
+    drive_torque_[1] = (0.5 * forward + yaw / track_width_) * r;
   }
 }
 

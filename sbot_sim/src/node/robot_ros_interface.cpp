@@ -16,9 +16,6 @@ namespace sbot_node {
 
 namespace {
 
-/// The cmd_vel track separation comes from this joint's lateral offset (seed: centre wheels 8.2 cm).
-constexpr const char* kTrackJoint = "left_wheel_joint";
-constexpr double kFallbackTrackSeparation = 0.082;  // [m] seed Table 2.2, centre wheels separation
 constexpr std::uint32_t kStateQueue = 100;
 
 int clampInt(long v, int lo, int hi) { return static_cast<int>(std::min<long>(hi, std::max<long>(lo, v))); }
@@ -58,22 +55,8 @@ void RobotRosInterface::bind(sbot::Robot& robot) {
   root_link_ = d.root_link.empty() ? std::string("base_link") : d.root_link;
   root_frame_ = name_ + "/" + root_link_;
 
-  const sbot::JointDescription* j = d.findJoint(kTrackJoint);
-  std::string source = kTrackJoint;
-  if (!j && !d.treels.left_joints.empty()) {
-    j = d.findJoint(d.treels.left_joints.front());
-    source = d.treels.left_joints.front();
-  }
-  double b = j ? 2.0 * std::abs(j->origin.position.y()) : 0.0;
-  if (b > 1e-4) {
-    track_separation_ = b;
-  } else {
-    track_separation_ = kFallbackTrackSeparation;
-    ROS_WARN("%s: level '%s' has no usable '%s' joint; cmd_vel uses the seed's track separation %.3f m",
-             name_.c_str(), d.level.c_str(), kTrackJoint, track_separation_);
-    source = "fallback";
-  }
-  ROS_DEBUG("%s: track separation %.4f m (from %s)", name_.c_str(), track_separation_, source.c_str());
+  track_separation_ = robot.trackWidth();
+  ROS_DEBUG("%s: track separation %.4f m", name_.c_str(), track_separation_);
 
   if (d.level != level_) {
     level_ = d.level;

@@ -49,6 +49,9 @@ class Robot {
   void getSpeed(int* left, int* right) const;
   /// Motor torques applied last step, API units (2.4412 mN m), in [-127,127].
   void getTrackTorque(int* left, int* right) const;
+  /// [m] lateral distance between the left and right driven wheels (mean of each side), measured
+  /// on the built model; the seed's 0.082 m (Table 2.2) if the wheels are not apart.
+  double trackWidth() const { return track_width_; }
   /// Passive treels (seed TreelsModule::setPassive): motors off, only the gear back-drive friction
   /// (treels.backdrive_force) resists rolling. Any setSpeed() makes them active again.
   void setTracksPassive(bool passive) { passive_ = passive; }
@@ -136,6 +139,7 @@ class Robot {
   /// Destroys every ODE object this robot owns (bodies, geoms, its space, hinges, loop joints, the
   /// body drive) and empties the bookkeeping: ~Robot and switchDescription.
   void destroyModel();
+  void measureTrackWidth();
   void buildBodyDrive();
   void applyBodyDrive(const TrackCommand& cmd);
   /// Track surface speed [m/s] the body drive sees: forward speed -/+ yaw rate * width / 2.
@@ -165,6 +169,8 @@ class Robot {
   std::vector<int> left_hinges_, right_hinges_;
   int turret_hinge_ = -1;
   Pose base_body_T_base_;                ///< base_link in its body's (centre of mass) frame
+  double track_width_ = 0.082;           ///< [m] see trackWidth()
+  bool wheels_apart_ = false;            ///< the model's driven wheels give the track width
 
   double req_left_ = 0, req_right_ = 0;  ///< requested track speeds [m/s]
   double turret_target_ = 0;             ///< [rad]
@@ -178,7 +184,6 @@ class Robot {
   dJointID drive_linear_ = nullptr;   ///< LMotor, axes chassis x and y
   dJointID drive_angular_ = nullptr;  ///< AMotor, axis chassis z
   dJointFeedback drive_linear_fb_{}, drive_angular_fb_{};
-  double drive_track_width_ = 0;      ///< [m] between the left and right driven wheels
   double drive_torque_[2] = {0, 0};   ///< [N m] per track (left, right), last step
 };
 

@@ -29,35 +29,9 @@ void undoSlip(PerRobot<std::pair<double, double>>& slip, const Robot& robot, Sen
   s.value += s.index == 0 ? d.first : d.second;
 }
 
-struct WidthCache {
-  std::map<const RobotDescription*, double> width;
-};
-
 }  // namespace
 
-double trackWidthOf(const Robot& robot) {
-  // Cached per description: the wheel links' lateral offsets in base_link, measured once.
-  static thread_local WidthCache cache;
-  const RobotDescription* d = &robot.description();
-  auto it = cache.width.find(d);
-  if (it != cache.width.end()) return it->second;
-  const Pose base_inv = robot.basePose().inverse();
-  auto side = [&](const std::vector<std::string>& joints) {
-    double sum = 0;
-    int n = 0;
-    for (const auto& jn : joints) {
-      const JointDescription* j = d->findJoint(jn);
-      if (!j || !robot.hasLink(j->child)) continue;
-      sum += (base_inv * robot.linkPose(j->child)).position.y();
-      ++n;
-    }
-    return n ? sum / n : 0.0;
-  };
-  double w = std::abs(side(d->treels.left_joints) - side(d->treels.right_joints));
-  if (!(w > 1e-3)) w = 0.082;  // Table 2.2: centre wheel separation
-  cache.width[d] = w;
-  return w;
-}
+double trackWidthOf(const Robot& robot) { return robot.trackWidth(); }
 
 double maxTrackSpeedOf(const Robot& robot) {
   const TreelsSemantics& t = robot.description().treels;

@@ -32,12 +32,6 @@
 namespace sbot {
 namespace {
 
-Pose odeBodyPose(dBodyID b) {
-  const dReal* p = dBodyGetPosition(b);
-  const dReal* q = dBodyGetQuaternion(b);
-  return Pose(Vec3(p[0], p[1], p[2]), Quat(q[0], q[1], q[2], q[3]));
-}
-
 void setOdeBodyPose(dBodyID b, const Pose& pose) {
   dBodySetPosition(b, pose.position.x(), pose.position.y(), pose.position.z());
   const Quat& q = pose.orientation;
