@@ -9,6 +9,8 @@
 //     single s-bot going backwards topples / fails at 32 mm.
 //
 //   two_sbots [--level detailed] [--trials 3] [--angles 10,20,...] [--steps 0.015,0.024,0.032]
+//             [--seed-friction]   (slope rows with the seed's force-limited 1.2 N friction, see
+//                                  two_sbots_trials.h; the step rows are unaffected)
 //
 // The connection is the static front-gripper link (core/swarm/swarm_graph.h createStaticLink: fixed
 // joint, gripper_tip to the held robot's turret, 0.147 m apart); the holder's arm is driven by the
@@ -44,7 +46,7 @@ int main(int argc, char** argv) {
   int trials = 3;
   std::vector<double> angles{10, 20, 25, 29, 32, 35, 40, 45, 50, 55, 58, 65, 72};
   std::vector<double> steps{0.015, 0.024, 0.032};
-  bool verbose = false;
+  bool verbose = false, seed_friction = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -53,12 +55,14 @@ int main(int argc, char** argv) {
     else if (a == "--angles") angles = parseList(next());
     else if (a == "--steps") steps = parseList(next());
     else if (a == "--verbose") verbose = true;
+    else if (a == "--seed-friction") seed_friction = true;
     else {
-      std::fprintf(stderr, "usage: two_sbots [--level L] [--trials N] [--angles deg,...] [--steps m,...] [--verbose]\n");
+      std::fprintf(stderr, "usage: two_sbots [--level L] [--trials N] [--angles deg,...] [--steps m,...] [--verbose] [--seed-friction]\n");
       return a == "--help" ? 0 : 2;
     }
   }
-  std::printf("two_sbots: level %s, %d trials per cell\n\n", level.c_str(), trials);
+  std::printf("two_sbots: level %s, %d trials per cell, friction %s\n\n", level.c_str(), trials,
+              seed_friction ? "seed (force limit 1.2 N per contact)" : "Coulomb (treels mu 1.0)");
   std::printf("Table 4.1 slope (stand 3 s, climb 8 s at 2.8 cm/s); label per trial (slide [mm], climb efficiency)\n");
   std::printf("%6s  %-60s %-60s\n", "deg", "single s-bot", "two s-bots connected");
   double limit_full = 0, limit_stable = 0, limit_upright = 0, single_upright = 0;
@@ -68,7 +72,7 @@ int main(int argc, char** argv) {
     bool all_full = true, all_stable = true, all_upright = true, single_upright_all = true;
     for (int pair = 0; pair < 2; ++pair) {
       for (int k = 0; k < trials; ++k) {
-        const SlopeResult r = pairSlope(level, deg * M_PI / 180, k, pair == 1);
+        const SlopeResult r = pairSlope(level, deg * M_PI / 180, k, pair == 1, seed_friction);
         char buf[96];
         std::snprintf(buf, sizeof(buf), "%s(%.0f,%.2f) ", r.label.c_str(), r.slide * 1000, r.efficiency);
         cells[pair] += buf;

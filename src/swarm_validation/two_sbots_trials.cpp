@@ -25,9 +25,15 @@ double tiltOf(const Robot& r) {
 
 }  // namespace
 
-SlopeResult pairSlope(const std::string& level, double angle, int trial, bool pair) {
+SlopeResult pairSlope(const std::string& level, double angle, int trial, bool pair, bool seed_friction) {
   WorldConfig c;
   c.seed = 7000 + trial;
+  if (seed_friction) {
+    constexpr double kSeedFrictionN = 1.2;  // 4.1.1 / Table 2.13: 12e4 dyne
+    c.contact.coulomb = false;
+    c.contact.mu = kSeedFrictionN;
+    c.contact.material_mu["track"] = kSeedFrictionN;
+  }
   World w(c);
   const double g = c.gravity;
   dWorldSetGravity(w.odeWorld(), -g * std::sin(angle), 0, -g * std::cos(angle));

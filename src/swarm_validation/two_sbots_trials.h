@@ -15,8 +15,10 @@ struct SlopeResult {
 };
 
 /// One s-bot (pair = false) or two connected by sbot_1's front gripper (sbot_0 uphill) on a slope of
-/// `angle` [rad] (tilted gravity): stand 3 s, climb 8 s.
-SlopeResult pairSlope(const std::string& level, double angle, int trial, bool pair);
+/// `angle` [rad] (tilted gravity): stand 3 s, climb 8 s. `seed_friction`: the seed's own set-up for
+/// this experiment (4.1.1: "ground friction ... set to ... 1.2 N"), i.e. ODE box friction with a
+/// force limit of 1.2 N per contact point, instead of our Coulomb treels (mu 1.0).
+SlopeResult pairSlope(const std::string& level, double angle, int trial, bool pair, bool seed_friction = false);
 
 struct StepResult {
   std::string label;  ///< pass, fail, topple
