@@ -115,24 +115,26 @@ FitResult fitModel(const Dataset& ds, const ModelSpec& start, const std::vector<
     J.resize(r0.size(), k);
     for (std::size_t j = 0; j < k; ++j) J.col(j) = (cols[j].stacked() - r0) / h[j];
 
-    // Flat start (e.g. a saturation that never binds at its null value) or a one-sided parameter:
-    // coarse scan once.
+    // Flat start (e.g. a saturation that never binds at its null value) or a parameter marked
+    // scan_first (ParamSpec): coarse scan once.
     if (it == 0 && opt.scan_flat) {
       for (std::size_t j = 0; j < k; ++j) {
         const bool flat = J.col(j).norm() * free[j].spec.scale <= 1e-3 * std::max(1.0, std::sqrt(cost));
-        if (!flat && !free[j].spec.one_sided) continue;
+        if (!flat && !free[j].spec.scan_first) continue;
         const ParamSpec& s = free[j].spec;
         std::vector<ModelSpec> scan;
-        std::vector<double> vals;
+        std::vector<double> vals, spacing;
         // Scan toward both bounds: a saturation binds on one side only (torque_saturation's scale
         // below 1), and which side is not knowable from a flat start.
         const double lo = std::isfinite(s.lower) ? s.lower : s.null_value - 10 * s.scale;
         const double hi = std::isfinite(s.upper) ? s.upper : s.null_value + 10 * s.scale;
         for (double bound : {lo, hi}) {
+          if (std::abs(bound - theta[j]) < 1e-12) continue;  // starting at this bound
           for (double f : {0.25, 0.5, 0.75}) {
             std::vector<double> th = theta;
             th[j] = theta[j] + f * (bound - theta[j]);
             vals.push_back(th[j]);
+            spacing.push_back(0.25 * std::abs(bound - theta[j]));
             scan.push_back(modelAt(th));
           }
         }
@@ -145,6 +147,31 @@ FitResult fitModel(const Dataset& ds, const ModelSpec& start, const std::vector<
           theta[j] = vals[best];
           cur = ev[best];
           cost = cur.rss();
+          // Refine by halving the spacing around the best point (3 times): a bracket search that,
+          // unlike the finite-difference descent below, is not misled by small-scale jitter of
+          // the cost (a slightly chaotic simulation).
+          double d = spacing[best];
+          for (int refine = 0; refine < 3; ++refine) {
+            d /= 2;
+            std::vector<ModelSpec> near;
+            std::vector<double> near_vals;
+            for (double v : {theta[j] - d, theta[j] + d}) {
+              if (v < s.lower || v > s.upper) continue;
+              std::vector<double> th = theta;
+              th[j] = v;
+              near_vals.push_back(v);
+              near.push_back(modelAt(th));
+            }
+            if (near.empty()) break;
+            const auto en = batch(ds, near, runs, opt.eval, pool);
+            tick();
+            for (std::size_t q = 0; q < en.size(); ++q)
+              if (en[q].rss() < cost) {
+                theta[j] = near_vals[q];
+                cur = en[q];
+                cost = cur.rss();
+              }
+          }
           // Re-derive this column at the new point.
           std::vector<double> th = theta;
           double hj = opt.fd_step * s.scale;

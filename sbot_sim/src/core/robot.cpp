@@ -509,6 +509,7 @@ void Robot::applyCommands(double dt, const std::vector<EffectPtr>& effects) {
   };
   if (drive_linear_) {
     applyBodyDrive(cmd);
+    applyRollingResistance(cmd);
   } else if (passive_) {
     // Motors off: the gears resist rolling with back-drive friction; pulling the robot takes
     // backdrive_force in total, half of it on each track.
@@ -519,6 +520,7 @@ void Robot::applyCommands(double dt, const std::vector<EffectPtr>& effects) {
     drive(left_hinges_, cmd.left, cmd.max_torque_left);
     drive(right_hinges_, cmd.right, cmd.max_torque_right);
   }
+  if (!drive_linear_) applyRollingResistance(cmd);
 
   if (turret_hinge_ >= 0) {
     // Position servo (the turret's PIC controller): proportional velocity demand capped at the
@@ -530,6 +532,34 @@ void Robot::applyCommands(double dt, const std::vector<EffectPtr>& effects) {
     dJointSetHingeParam(h.id, dParamVel, std::max(-ts.speed, std::min(ts.speed, kGain * err)));
     dJointSetHingeParam(h.id, dParamFMax, ts.max_torque);
   }
+}
+
+void Robot::applyRollingResistance(const TrackCommand& cmd) {
+  if (cmd.resist_torque_left <= 0 && cmd.resist_torque_right <= 0) return;
+  // Opposes the rotation with a smooth sign (tanh): a hard sign would chatter at standstill.
+  constexpr double kRollingSpeed = 0.005;  // [m/s] below this the resistance fades out linearly
+  const double r = description_->treels.wheel_radius;
+  if (drive_linear_) {
+    // Body drive (Fast): the two tracks' resistances as one force against the forward speed.
+    const Quat q = bodyPose(baseBody()).orientation;
+    const Vec3 heading = q * Vec3::UnitX();
+    const double v = linearVelocity().dot(heading);
+    const double f = (cmd.resist_torque_left + cmd.resist_torque_right) / r * std::tanh(v / kRollingSpeed);
+    dBodyAddForce(baseBody(), -f * heading.x(), -f * heading.y(), -f * heading.z());
+    return;
+  }
+  auto resist = [this](const std::vector<int>& side, double torque) {
+    if (side.empty() || torque <= 0) return;
+    for (int i : side) {
+      const Hinge& h = hinges_[i];
+      const double rim_speed = hingeRate(h) * description_->wheelRadius(h.name);
+      // Between wheel and chassis, like bearing friction: the motor's constraint torque (the
+      // torque reading) grows by the same amount.
+      dJointAddHingeTorque(h.id, -torque / side.size() * std::tanh(rim_speed / kRollingSpeed));
+    }
+  };
+  resist(left_hinges_, cmd.resist_torque_left);
+  resist(right_hinges_, cmd.resist_torque_right);
 }
 
 void Robot::applyBodyDrive(const TrackCommand& cmd) {

@@ -1,6 +1,7 @@
 // Pluggable physical effects. An effect is a small object hooked into one or more of three paths:
-//   command  — between the API's requested track speeds and the motors (latency, dead-band, lag, ...)
-//   contact  — on every contact the world creates (friction anisotropy, rolling resistance, ...)
+//   command  — between the API's requested track speeds and the motors (latency, dead-band, lag,
+//              rolling resistance, ...)
+//   contact  — on every contact the world creates (friction anisotropy, ...)
 //   sensor   — on every raw sensor value before quantisation (reflectance, gain, offset, ...)
 // The calibration workbench fits effects' parameters; the simulator and scenarios load the same
 // effects files, so an accepted effect becomes part of every simulation.
@@ -22,6 +23,10 @@ class Robot;
 struct TrackCommand {
   double left = 0, right = 0;          ///< requested track surface speed [m/s]
   double max_torque_left = 0, max_torque_right = 0;  ///< [N m] available at the axle
+  /// [N m] per track, opposing the wheels' rotation (rolling resistance): the robot applies it at
+  /// the wheel axles every step, so the motors must supply it (higher torque readings, earlier
+  /// saturation) and a free-rolling robot slows down.
+  double resist_torque_left = 0, resist_torque_right = 0;
 };
 
 /// One contact about to be created between two geoms. `robot` is null for static geometry.

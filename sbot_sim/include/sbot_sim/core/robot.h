@@ -142,6 +142,7 @@ class Robot {
   void measureTrackWidth();
   void buildBodyDrive();
   void applyBodyDrive(const TrackCommand& cmd);
+  void applyRollingResistance(const TrackCommand& cmd);  ///< TrackCommand::resist_torque_*
   /// Track surface speed [m/s] the body drive sees: forward speed -/+ yaw rate * width / 2.
   double bodyDriveTrackSpeed(int side) const;
   void addReflectedRotorInertia(const std::vector<int>& track);

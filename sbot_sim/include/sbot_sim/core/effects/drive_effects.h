@@ -134,13 +134,13 @@ class BatterySagEffect : public ParametricEffect {
   PerRobot<double> elapsed_;
 };
 
-/// Rolling resistance of the tracks: ODE rolling friction on every contact of a "track" material,
-/// torque limit = coefficient x wheel radius x normal force.
+/// Rolling resistance of the tracks: a torque of coefficient x wheel radius x normal load per
+/// track, opposing the wheels' rotation (TrackCommand::resist_torque_*).
 class RollingResistanceEffect : public ParametricEffect {
  public:
   explicit RollingResistanceEffect(const std::map<std::string, double>& p);
   static EffectInfo describe();
-  void onContact(const ContactContext& ctx, dSurfaceParameters& surface) override;
+  void onCommand(const Robot& robot, TrackCommand& cmd, double dt) override;
 };
 
 /// Anisotropic track friction: along the track (robot heading) mu; across it lateral_ratio x mu.
