@@ -40,17 +40,18 @@ Outcome drive(const std::vector<EffectConfig>& effects, int l, int r, double sec
     o.turned += wrapAngle(y - last);
     last = y;
     o.x.push_back(robot.basePose().position.x());
-    if (k >= n - 100) {
+    if (k >= n - 100) {  // torque and encoder: means over the last second (single samples jitter)
       int tl, tr;
       robot.getTrackTorque(&tl, &tr);
       o.torque_left += tl;
+      SensorSample s{kTrackSpeedChannel, 0, robot.trackSpeedLeft(), "", 0};
+      for (const auto& e : w.effects()) e->onSensor(robot, s);
+      o.encoder_left += s.value;
       ++torque_n;
     }
   }
   o.torque_left /= std::max(1, torque_n);
-  SensorSample s{kTrackSpeedChannel, 0, robot.trackSpeedLeft(), "", 0};
-  for (const auto& e : w.effects()) e->onSensor(robot, s);
-  o.encoder_left = s.value;
+  o.encoder_left /= std::max(1, torque_n);
   const Pose p = robot.basePose();
   o.pose = {p.position.x(), p.position.y(), p.yaw()};
   return o;
