@@ -213,7 +213,7 @@ std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool) {
 
 std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions& opt, double seconds) {
   std::ostringstream md;
-  md << "Sweep: " << opt.seeds << " seeds per case, level " << opt.gen.level << ", drive patterns of "
+  md << "Sweep: " << opt.seeds << " seeds per case, level " << opt.gen.level << " (unless the case names one), drive patterns of "
      << opt.gen.duration << " s, solver " << opt.gen.solver << ", " << opt.diag.folds << "-fold split by run, acceptance dBIC > "
      << opt.diag.bic_threshold << "; " << std::fixed << std::setprecision(0) << seconds << " s wall.\n\n";
   md << "| hidden | truth | right first | params +-10 % | held-out RMS -50 % | ends <= 1.2x floor | nothing accepted | "

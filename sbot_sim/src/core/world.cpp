@@ -254,11 +254,6 @@ void World::handlePair(dGeomID a, dGeomID b) {
     const Vec3 along = heading - heading.dot(ctx.normal) * ctx.normal;
     ctx.fdir1 = along.norm() > 1e-9 ? Vec3(along.normalized()) : Vec3::Zero();
     contacts[i].surface = surface;
-    // A robot's friction pyramid (dContactApprox1) is aligned with its heading, not with ODE's
-    // world-derived default directions: otherwise the same robot spins ~3 % faster heading 45 deg
-    // than heading 0 (Medium/Detailed), and track_friction_anisotropy's null would differ from
-    // lateral_ratio -> 1 (it aligns the pyramid).
-    if (mover && ctx.fdir1.squaredNorm() > 0) contacts[i].surface.mode |= dContactFDir1;
     for (const auto& e : effects_) e->onContact(ctx, contacts[i].surface);
     if (contacts[i].surface.mode & dContactFDir1) {
       for (int k = 0; k < 3; ++k) contacts[i].fdir1[k] = ctx.fdir1[k];
