@@ -15,14 +15,13 @@ the run is judged from t = 0.
 import math
 import sys
 import threading
-import time
 import unittest
 
-import rosgraph
 import rospy
 import rostest
 from nav_msgs.msg import Odometry
-from std_srvs.srv import Trigger
+
+from paused_sim import unpause_and_run, wait_for_controllers
 
 
 class ControllerOutcome(unittest.TestCase):
@@ -67,33 +66,18 @@ class ControllerOutcome(unittest.TestCase):
                 if abs(p[0]) > half or abs(p[1]) > half:
                     self.collisions.append('t=%.2f %s-wall at (%.3f, %.3f)' % (t - self.t0, robot, p[0], p[1]))
 
-    def wait_controllers(self, timeout=60.0):
-        master = rosgraph.Master('/sbot_api_controller_test')
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            pubs = {t: n for t, n in master.getSystemState()[0]}
-            if all(any(not n.startswith('/simulator') for n in pubs.get('/%s/cmd_speed' % r, []))
-                   for r in self.robots):
-                return
-            time.sleep(0.2)
-        self.fail('controllers did not start within %.0f s' % timeout)
+    def simulated(self):
+        """[s] simulated so far; 0 until every robot has reported."""
+        with self.lock:
+            if self.t0 is None or len(self.pose) < len(self.robots):
+                return 0.0
+            return self.t_last - self.t0
 
     def test_outcome(self):
         rospy.wait_for_service('/sim/unpause', 60.0)
-        self.wait_controllers()
-        for s in self.subs:
-            deadline = time.monotonic() + 20
-            while s.get_num_connections() == 0 and time.monotonic() < deadline:
-                time.sleep(0.05)
-        wall0 = time.monotonic()
-        rospy.ServiceProxy('/sim/unpause', Trigger)()
-        deadline = time.monotonic() + 600
-        while time.monotonic() < deadline:
-            with self.lock:
-                if self.t0 is not None and self.t_last - self.t0 >= self.duration and len(self.pose) == len(self.robots):
-                    break
-            time.sleep(0.05)
-        wall = time.monotonic() - wall0
+        if not wait_for_controllers('/sbot_api_controller_test', self.robots, 'cmd_speed', publishers=True):
+            self.fail('controllers did not start within 60 s')
+        wall = unpause_and_run(self.subs, self.simulated, self.duration, 600)
         with self.lock:
             sim = self.t_last - (self.t0 or 0)
             rospy.loginfo('%s: %.1f s simulated in %.1f s wall (RTM %.1f); travel %s', self.mode, sim, wall,

@@ -14,15 +14,14 @@ is judged from t = 0.
 import math
 import sys
 import threading
-import time
 import unittest
 
-import rosgraph
 import rospy
 import rostest
 from nav_msgs.msg import Odometry
 from sbot_msgs.msg import SwarmGraph
-from std_srvs.srv import Trigger
+
+from paused_sim import unpause_and_run, wait_for_controllers
 
 
 def tilt_deg(q):
@@ -71,16 +70,9 @@ class TwoSbotsStep(unittest.TestCase):
                 if self.gripped_at is None:
                     self.gripped_at = msg.header.stamp.to_sec() - (self.t0 or 0.0)
 
-    def wait_controllers(self, timeout=60.0):
-        master = rosgraph.Master('/two_sbots_step_test')
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            subs = {t: n for t, n in master.getSystemState()[1]}
-            if all(any(not n.startswith('/simulator') for n in subs.get('/%s/slope' % r, []))
-                   for r in self.robots):
-                return
-            time.sleep(0.2)
-        self.fail('controllers did not subscribe to their slope topics within %.0f s' % timeout)
+    def simulated(self):
+        with self.lock:
+            return self.t_last - self.t0 if self.t0 is not None else 0.0
 
     def on_plateau(self, robot):
         x, _, z, tilt = self.pose[robot]
@@ -88,26 +80,16 @@ class TwoSbotsStep(unittest.TestCase):
 
     def test_pair_passes_single_topples(self):
         rospy.wait_for_service('/sim/unpause', 60.0)
-        self.wait_controllers()
-        for s in self.subs:
-            deadline = time.monotonic() + 20
-            while s.get_num_connections() == 0 and time.monotonic() < deadline:
-                time.sleep(0.05)
-        wall0 = time.monotonic()
-        rospy.ServiceProxy('/sim/unpause', Trigger)()
-        deadline = time.monotonic() + 400
-        while time.monotonic() < deadline:
-            with self.lock:
-                if self.t0 is not None and self.t_last - self.t0 >= self.duration:
-                    break
-            time.sleep(0.1)
+        if not wait_for_controllers('/two_sbots_step_test', self.robots, 'slope', publishers=False):
+            self.fail('controllers did not subscribe to their slope topics within 60 s')
+        wall = unpause_and_run(self.subs, self.simulated, self.duration, 400)
         with self.lock:
             sim = self.t_last - (self.t0 or 0.0)
             report = ', '.join('%s x %.3f z %.3f tilt %.0f deg (max %.0f)' % (
                 r, self.pose[r][0], self.pose[r][2], self.pose[r][3], self.max_tilt[r])
                 for r in self.robots if r in self.pose)
             print('two_sbots_step: %.1f s simulated in %.1f s wall; gripped at %s s; %s'
-                  % (sim, time.monotonic() - wall0, self.gripped_at, report), file=sys.stderr)
+                  % (sim, wall, self.gripped_at, report), file=sys.stderr)
             self.assertGreaterEqual(sim, self.duration - 0.1, 'the simulation did not get far enough: ' + report)
             self.assertIsNotNone(self.gripped_at, '%s never gripped %s (no FRONT_GRIPPER link on /swarm/graph)'
                                  % (self.holder, self.held))

@@ -62,6 +62,13 @@ static void onWarning(const char *text) { fprintf(stderr, "[step_climbing] warni
 
 static void leds(unsigned r, unsigned g, unsigned b) { setSameLightColor(r, g, b, BLINKING_RATE_NO_BLINK); }
 
+/* End of the script: tracks stopped, LEDs green (done) or red (gave up, toppled). */
+static void finish(int done) {
+  setSpeed(0, 0);
+  if (done) leds(0, 15, 0);
+  else leds(15, 0, 0);
+}
+
 /* One sample of the robot's own state; blocks until the inclinometer's next sample (0.1 s). */
 typedef struct {
   double t;     /* [s] simulated since start */
@@ -136,8 +143,19 @@ static int grip(Sample *s) {
   return 1;
 }
 
+/* The holder's arm after it senses the step: down (braced on the held robot, its rear climbs the
+ * step face), level (reversing until the held robot is at the step), up (lifting the held robot's
+ * rear onto the step). */
+typedef struct {
+  int elevation;   /* [deg] */
+  double seconds;  /* [s] simulated */
+} ArmStep;
+static const ArmStep kArmSchedule[] = {{ARM_DOWN, LIFT_S}, {0, LEVEL_S}, {ARM_UP, RAISE_S}};
+#define ARM_STEPS ((int)(sizeof(kArmSchedule) / sizeof(kArmSchedule[0])))
+
 static void holder(void) {
-  enum { REVERSING, LIFTING, LEVELLING, RAISING, PULLING } phase = REVERSING;
+  /* phase: -1 reversing to the step, 0..ARM_STEPS-1 the arm schedule, ARM_STEPS pulling */
+  int phase = -1;
   Sample s = {0, 0, 0};
   PlateauDetector plateau = {0, -1};
   int pitch0, loaded = 0;
@@ -152,50 +170,38 @@ static void holder(void) {
   pitch0 = s.pitch;
   while (running && s.t < START_S) s = next(s);
   since = s.t;
-  while (running) {
+  while (running && s.t <= TIMEOUT_S) {
     int done;
     setSpeed(REVERSE, REVERSE);
     s = next(s);
-    done = phase != REVERSING && onPlateau(&plateau, s, pitch0, DONE_LEVEL_S);
-    phase_now = phase;
-    switch (phase) {
-      case REVERSING:
-        setGripperElevation(0);
-        /* (the first second of reversing loads the tracks too: accelerating the pair) */
-        if (s.t - since > 1.0 &&
-            streak(&loaded, s.load > LOAD_TORQUE || abs(s.pitch - pitch0) >= STEP_TILT)) {
-          printf("[step_climbing] holder: step sensed at t %.1f s (load %.0f, pitch %d)\n", s.t, s.load, s.pitch);
-          phase = LIFTING;
-          since = s.t;
-          leds(15, 15, 0);
-        }
-        break;
-      case LIFTING:
-        setGripperElevation(ARM_DOWN);
-        if (s.t - since >= LIFT_S) { phase = LEVELLING; since = s.t; }
-        break;
-      case LEVELLING:
-        setGripperElevation(0);
-        if (s.t - since >= LEVEL_S) { phase = RAISING; since = s.t; }
-        break;
-      case RAISING:
-        setGripperElevation(ARM_UP);
-        if (s.t - since >= RAISE_S) { phase = PULLING; since = s.t; }
-        break;
-      case PULLING:
-        setGripperElevation(0);
-        if (done) {
-          printf("[step_climbing] holder: on the plateau at t %.1f s\n", s.t);
-          setSpeed(0, 0);
-          leds(0, 15, 0);
-          return;
-        }
-        break;
+    phase_now = phase + 1;
+    done = phase >= 0 && onPlateau(&plateau, s, pitch0, DONE_LEVEL_S);
+    if (phase < 0) {
+      setGripperElevation(0);
+      /* (the first second of reversing loads the tracks too: accelerating the pair) */
+      if (s.t - since > 1.0 &&
+          streak(&loaded, s.load > LOAD_TORQUE || abs(s.pitch - pitch0) >= STEP_TILT)) {
+        printf("[step_climbing] holder: step sensed at t %.1f s (load %.0f, pitch %d)\n", s.t, s.load, s.pitch);
+        phase = 0;
+        since = s.t;
+        leds(15, 15, 0);
+      }
+    } else if (phase < ARM_STEPS) {
+      setGripperElevation(kArmSchedule[phase].elevation);
+      if (s.t - since >= kArmSchedule[phase].seconds) {
+        ++phase;
+        since = s.t;
+      }
+    } else {
+      setGripperElevation(0);
+      if (done) {
+        printf("[step_climbing] holder: on the plateau at t %.1f s\n", s.t);
+        finish(1);
+        return;
+      }
     }
-    if (s.t > TIMEOUT_S) break;
   }
-  setSpeed(0, 0);
-  leds(15, 0, 0);
+  finish(0);
 }
 
 static void held(void) {
@@ -237,16 +243,14 @@ static void held(void) {
           pushing_since = s.t;
         } else if (s.t - pushing_since >= PUSH_S) {
           printf("[step_climbing] held: over the step, pushing the stopped holder at t %.1f s: stop\n", s.t);
-          setSpeed(0, 0);
-          leds(0, 15, 0);
+          finish(1);
           return;
         }
         break;
     }
     s = next(s);
   }
-  setSpeed(0, 0);
-  leds(15, 0, 0);
+  finish(0);
 }
 
 static void single(void) {
@@ -261,19 +265,16 @@ static void single(void) {
     s = next(s);
     if (abs(s.pitch - pitch0) > TOPPLE_TILT) {
       printf("[step_climbing] single: toppled (pitch %d deg) at t %.1f s\n", s.pitch, s.t);
-      setSpeed(0, 0);
-      leds(15, 0, 0);
+      finish(0);
       return;
     }
     if (onPlateau(&plateau, s, pitch0, DONE_LEVEL_S)) {
       printf("[step_climbing] single: on the plateau at t %.1f s\n", s.t);
-      setSpeed(0, 0);
-      leds(0, 15, 0);
+      finish(1);
       return;
     }
   }
-  setSpeed(0, 0);
-  leds(15, 0, 0);
+  finish(0);
 }
 
 int main(int argc, char **argv) {
