@@ -378,6 +378,7 @@ DiagnoseResult diagnose(const Dataset& ds, const DiagnoseOptions& opt, WorkerPoo
           }
           FitOptions f = fo;
           f.max_iterations = t.iterations;
+          f.refine_scan = t.iterations >= fo.max_iterations;  // screening ranks by the coarse scan
           // The start model equals the current model when the candidate starts at its null value.
           if (t.start.empty()) f.start_evaluation = &cur_train[t.fold];
           FitTask r;

@@ -147,11 +147,12 @@ FitResult fitModel(const Dataset& ds, const ModelSpec& start, const std::vector<
           theta[j] = vals[best];
           cur = ev[best];
           cost = cur.rss();
-          // Refine by halving the spacing around the best point (3 times): a bracket search that,
-          // unlike the finite-difference descent below, is not misled by small-scale jitter of
-          // the cost (a slightly chaotic simulation).
-          double d = spacing[best];
-          for (int refine = 0; refine < 3; ++refine) {
+          // scan_first parameters: refine by halving the spacing around the best point (3 times),
+          // a bracket search that, unlike the finite-difference descent below, is not misled by
+          // small-scale jitter of the cost (rolling_resistance). Only scan_first: the other flat
+          // starts (accel_limit, a saturation) are served by the descent.
+          double d = s.scan_first && opt.refine_scan ? spacing[best] : 0.0;
+          for (int refine = 0; refine < 3 && d > 0; ++refine) {
             d /= 2;
             std::vector<ModelSpec> near;
             std::vector<double> near_vals;

@@ -25,6 +25,10 @@ struct FitOptions {
                                  ///< simulation is slightly chaotic, small steps give noisy slopes)
   double tolerance = 1e-4;       ///< stop when the relative cost decrease is below this
   bool scan_flat = true;         ///< coarse scan when the gradient at the start is flat
+  /// Bracket refinement after the coarse scan of a scan_first parameter (fit.cpp). Off for
+  /// diagnose's screening fits: with it, a scan_first candidate (torque_saturation) out-ranked a
+  /// slowly converging true latency and pushed it out of the finalists (4/10 Simple datasets).
+  bool refine_scan = true;
   EvalOptions eval;
   /// Residuals of the start model on the fit runs when already known (saves one re-simulation).
   const Evaluation* start_evaluation = nullptr;
