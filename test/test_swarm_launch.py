@@ -3,13 +3,13 @@
 
 For every robot sbot_<i> (i < ~robots):
   - /sbot_<i>/ground_truth publishes, and the robot moves (its random_walk controller drives it):
-    it ends at least ~min_travel away from where it was first seen, and /sbot_<i>/cmd_speed carries
-    commands;
+    its base travels at least ~min_travel (path length) or turns at least ~min_turn (a random walker
+    turning on the spot at a wall is driven too), and /sbot_<i>/cmd_speed carries commands;
   - /tf carries world -> sbot_<i>/base_link (from the simulator) and sbot_<i>/base_link ->
     sbot_<i>/turret (from /sbot_<i>/robot_state_publisher, the turret joint being revolute).
 
 Private parameters: ~robots (required), ~sim_window [s sim] to watch (default 5), ~min_travel [m]
-(default 0.05), ~timeout [s wall] for everything to come up (default 40).
+(default 0.05), ~min_turn [rad] (default 0.5), ~timeout [s wall] for everything to come up (default 40).
 """
 import math
 import threading
@@ -36,8 +36,10 @@ class SwarmLaunchTest(unittest.TestCase):
         cls.timeout = float(rospy.get_param('~timeout', 40.0))
         cls.names = ['sbot_%d' % i for i in range(cls.robots)]
         cls.lock = threading.Lock()
-        cls.first = {}        # robot -> (x, y) first ground truth
-        cls.last = {}         # robot -> (x, y) latest ground truth
+        cls.min_turn = float(rospy.get_param('~min_turn', 0.5))
+        cls.last = {}         # robot -> (x, y, yaw) latest ground truth
+        cls.path = {r: 0.0 for r in cls.names}   # [m] base path length
+        cls.turn = {r: 0.0 for r in cls.names}   # [rad] accumulated |yaw change|
         cls.gt_count = {r: 0 for r in cls.names}
         cls.cmd_count = {r: 0 for r in cls.names}
         cls.cmd_nonzero = {r: 0 for r in cls.names}
@@ -84,8 +86,13 @@ class SwarmLaunchTest(unittest.TestCase):
         p = msg.pose.pose.position
         with cls.lock:
             cls.gt_count[robot] += 1
-            cls.first.setdefault(robot, (p.x, p.y))
-            cls.last[robot] = (p.x, p.y)
+            q = msg.pose.pose.orientation
+            yaw = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
+            if robot in cls.last:
+                x0, y0, yaw0 = cls.last[robot]
+                cls.path[robot] += math.hypot(p.x - x0, p.y - y0)
+                cls.turn[robot] += abs(math.remainder(yaw - yaw0, 2 * math.pi))
+            cls.last[robot] = (p.x, p.y, yaw)
 
     @classmethod
     def on_cmd(cls, msg, robot):
@@ -115,14 +122,12 @@ class SwarmLaunchTest(unittest.TestCase):
 
     def test_2_robots_move(self):
         with self.lock:
-            travel = {r: math.hypot(self.last[r][0] - self.first[r][0], self.last[r][1] - self.first[r][1])
-                      for r in self.names if r in self.first}
+            moved = {r: (round(self.path[r], 3), round(self.turn[r], 2)) for r in self.names}
             no_cmd = [r for r in self.names if self.cmd_nonzero[r] == 0]
-        still = sorted(r for r in self.names if travel.get(r, 0.0) < self.min_travel)
+        still = sorted(r for r in self.names if moved[r][0] < self.min_travel and moved[r][1] < self.min_turn)
         self.assertEqual(no_cmd, [], 'robots whose controller sent no non-zero cmd_speed: %s' % no_cmd)
-        self.assertEqual(still, [], 'robots that moved less than %.2f m in %.1f s sim: %s (travel %s)'
-                         % (self.min_travel, self.sim_window, still,
-                            {r: round(travel.get(r, 0.0), 3) for r in still}))
+        self.assertEqual(still, [], 'robots that neither travelled %.2f m nor turned %.1f rad (path [m], turn [rad]): %s'
+                         % (self.min_travel, self.min_turn, {r: moved[r] for r in still}))
 
     def test_3_tf_tree(self):
         with self.lock:
