@@ -470,9 +470,15 @@ DiagnoseResult diagnose(const Dataset& ds, const DiagnoseOptions& opt, WorkerPoo
     std::sort(rank.begin(), rank.end(),
               [&](std::size_t a, std::size_t b) { return screened[a].delta_bic > screened[b].delta_bic; });
     const std::size_t finalists = std::min<std::size_t>(rank.size(), static_cast<std::size_t>(opt.finalists));
-    for (std::size_t q = 0; q < finalists; ++q)
+    for (std::size_t q = 0; q < finalists; ++q) {
+      // A candidate with a scan_first parameter is refitted from its null value: its full fit scans
+      // the whole range and refines (from the screening's coarse point it would scan a sub-range).
+      bool scan_first = false;
+      for (const auto& p : EffectRegistry::instance().info(todo[rank[q]]).params) scan_first |= p.scan_first;
       for (int f = 0; f < K; ++f)
-        refine.push_back({todo[rank[q]], f, screened[rank[q]].fold_values[f], fo.max_iterations});
+        refine.push_back({todo[rank[q]], f,
+                          scan_first ? std::vector<double>{} : screened[rank[q]].fold_values[f], fo.max_iterations});
+    }
     const auto rres = runTasks(refine, tag + "refining " + std::to_string(finalists) + " best");
     const std::size_t off = 0;
     for (std::size_t q = 0; q < rank.size(); ++q) {
