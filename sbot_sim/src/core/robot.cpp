@@ -509,7 +509,6 @@ void Robot::applyCommands(double dt, const std::vector<EffectPtr>& effects) {
   };
   if (drive_linear_) {
     applyBodyDrive(cmd);
-    applyRollingResistance(cmd);
   } else if (passive_) {
     // Motors off: the gears resist rolling with back-drive friction; pulling the robot takes
     // backdrive_force in total, half of it on each track.
@@ -520,7 +519,7 @@ void Robot::applyCommands(double dt, const std::vector<EffectPtr>& effects) {
     drive(left_hinges_, cmd.left, cmd.max_torque_left);
     drive(right_hinges_, cmd.right, cmd.max_torque_right);
   }
-  if (!drive_linear_) applyRollingResistance(cmd);
+  applyRollingResistance(cmd);
 
   if (turret_hinge_ >= 0) {
     // Position servo (the turret's PIC controller): proportional velocity demand capped at the

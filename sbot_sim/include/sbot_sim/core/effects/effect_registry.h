@@ -27,10 +27,9 @@ struct ParamSpec {
   double upper = std::numeric_limits<double>::infinity();
   double scale = 1;          ///< typical magnitude of a departure from null (fit step, damping)
   std::string description;
-  /// The cost is not smooth away from null, so the local gradient there misleads the fitter: a
-  /// saturation that binds on one side only (torque_saturation below 1), or a stick-slip contact
-  /// effect with local minima near null (rolling_resistance: ODE's rolling friction; for a true
-  /// 0.2 the cost has a dip at 0.012). The fitter coarse-scans the range before descending.
+  /// The local gradient at the start misleads the fitter: a saturation that binds on one side of
+  /// null only (torque_saturation below 1), or a cost that jitters at small scales on the six-wheel
+  /// model (rolling_resistance). The fitter coarse-scans the range and refines before descending.
   bool scan_first = false;
 };
 
