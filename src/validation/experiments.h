@@ -25,7 +25,8 @@ struct Outcome {
 /// Speed used by the seed for gap and slope experiments (4.2.3, 4.2.4): 2.8 cm/s = 10 API units.
 constexpr int kSlowUnits = 10;
 
-/// Table 4.2 / 4.5: drive at 2.8 cm/s across a gap `gap_m` wide between two 10 cm high platforms.
+/// Table 4.2 / 4.5: drive at 2.8 cm/s across a gap `gap_m` wide between two 10 cm high platforms
+/// (Fast: half as wide, like its half-size terrain in 4.2.2).
 /// Labels: pass, stuck (fell inside or stuck at the edge), topple.
 Outcome gapTrial(const std::string& level, double gap_m, int trial);
 
