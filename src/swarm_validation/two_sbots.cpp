@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "experiments.h"
 #include "two_sbots_trials.h"
 
 namespace {
@@ -65,37 +66,28 @@ int main(int argc, char** argv) {
               seed_friction ? "seed (force limit 1.2 N per contact)" : "Coulomb (treels mu 1.0)");
   std::printf("Table 4.1 slope (stand 3 s, climb 8 s at 2.8 cm/s); label per trial (slide [mm], climb efficiency)\n");
   std::printf("%6s  %-60s %-60s\n", "deg", "single s-bot", "two s-bots connected");
-  double limit_full = 0, limit_stable = 0, limit_upright = 0, single_upright = 0;
-  bool full_run = true, stable_run = true, upright_run = true, single_run = true;
+  std::vector<std::string> modal[2];  // per slope: single s-bot, pair
   for (double deg : angles) {
     std::string cells[2];
-    bool all_full = true, all_stable = true, all_upright = true, single_upright_all = true;
     for (int pair = 0; pair < 2; ++pair) {
+      std::vector<sbot::validation::Outcome> trial_labels;
       for (int k = 0; k < trials; ++k) {
         const SlopeResult r = pairSlope(level, deg * M_PI / 180, k, pair == 1, seed_friction);
         char buf[96];
         std::snprintf(buf, sizeof(buf), "%s(%.0f,%.2f) ", r.label.c_str(), r.slide * 1000, r.efficiency);
         cells[pair] += buf;
-        if (pair == 1) {
-          all_full &= r.label == "full";
-          all_stable &= r.label != "topple" && r.label != "slide";
-          all_upright &= r.label != "topple";
-        } else {
-          single_upright_all &= r.label != "topple";
-        }
+        trial_labels.push_back({r.label});
       }
+      modal[pair].push_back(sbot::validation::modal(trial_labels));
     }
-    if (all_full && full_run) limit_full = deg; else full_run = false;
-    if (all_stable && stable_run) limit_stable = deg; else stable_run = false;
-    if (all_upright && upright_run) limit_upright = deg; else upright_run = false;
-    if (single_upright_all && single_run) single_upright = deg; else single_run = false;
     std::printf("%6.0f  %-60s %-60s\n", deg, cells[0].c_str(), cells[1].c_str());
     std::fflush(stdout);
   }
-  std::printf("\ntwo s-bots connected: limit of full manoeuvrability %.0f deg (seed 29); standing without sliding "
-              "(> 1 cm in 3 s) up to %.0f deg; never toppling up to %.0f deg (seed 'limit of stable position' "
-              "58-72 deg); a single s-bot topples from the first angle after %.0f deg\n\n",
-              limit_full, limit_stable, limit_upright, single_upright);
+  const SlopeLimits single = slopeLimits(angles, modal[0]), two = slopeLimits(angles, modal[1]);
+  std::printf("\ntwo s-bots connected (modal of %d): limit of full manoeuvrability %.0f deg (seed 29); standing "
+              "without sliding (> 1 cm in 3 s) up to %.0f deg; upright up to %.0f deg%s (seed 'limit of stable "
+              "position' 58-72 deg); a single s-bot upright up to %.0f deg\n\n",
+              trials, two.full, two.hold, two.upright, two.topple > 0 ? "" : " (never toppled)", single.upright);
 
   std::printf("4.1.3 step, going backwards (40 s limit)\n");
   for (double h : steps) {

@@ -171,4 +171,19 @@ StepResult stepBackward(const std::string& level, double h, int trial, bool pair
   return res;
 }
 
+SlopeLimits slopeLimits(const std::vector<double>& deg, const std::vector<std::string>& modal_labels) {
+  SlopeLimits l;
+  bool full_run = true, hold_run = true;
+  for (std::size_t k = 0; k < deg.size() && k < modal_labels.size(); ++k) {
+    const std::string& m = modal_labels[k];
+    full_run &= m == "full";
+    hold_run &= m != "slide" && m != "topple" && m.find("slides") == std::string::npos;
+    if (full_run) l.full = deg[k];
+    if (hold_run) l.hold = deg[k];
+    if (m == "topple" && l.topple == 0) l.topple = deg[k];
+    if (l.topple == 0) l.upright = deg[k];
+  }
+  return l;
+}
+
 }  // namespace two_sbots

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace two_sbots {
 
@@ -19,6 +20,16 @@ struct SlopeResult {
 /// this experiment (4.1.1: "ground friction ... set to ... 1.2 N"), i.e. ODE box friction with a
 /// force limit of 1.2 N per contact point, instead of our Coulomb treels (mu 1.0).
 SlopeResult pairSlope(const std::string& level, double angle, int trial, bool pair, bool seed_friction = false);
+
+/// The Table 4.1 pair rows' limits [deg], from the modal label of the trials at each slope
+/// (`deg` ascending, `modal_labels` parallel to it). One rule for the two_sbots tool and sbot_validate.
+struct SlopeLimits {
+  double full = 0;     ///< steepest slope up to which every modal label is "full" (full manoeuvrability)
+  double hold = 0;     ///< steepest slope up to which it neither slides nor topples
+  double upright = 0;  ///< steepest slope before the first modal "topple" (limit of stable position)
+  double topple = 0;   ///< first slope whose modal label is "topple"; 0: none in the list
+};
+SlopeLimits slopeLimits(const std::vector<double>& deg, const std::vector<std::string>& modal_labels);
 
 struct StepResult {
   std::string label;  ///< pass, fail, topple

@@ -267,8 +267,7 @@ int main(int argc, char** argv) {
     const std::vector<double> deg{25, 29, 32, 35, 40, 45, 50, 55, 58, 65, 72};
     // Both friction laws: ours (Coulomb treels, the model's default) and the seed's own set-up for
     // this experiment (4.1.1: force limit 1.2 N per contact). See two_sbots_trials.h.
-    struct Limits {
-      double full = 0, hold = 0, upright = 0, topple = 0;  // [deg]; topple 0 = never
+    struct Limits : two_sbots::SlopeLimits {
       std::string detail;
     };
     auto limitsFor = [&](bool seed_friction) {
@@ -280,19 +279,14 @@ int main(int argc, char** argv) {
         out.value2 = r.efficiency;
         return out;
       });
-      Limits l;
-      bool full_run = true, hold_run = true;
+      std::vector<std::string> modal;
+      std::string detail;
       for (std::size_t k = 0; k < deg.size(); ++k) {
         std::vector<Outcome> c(res.begin() + k * o.trials, res.begin() + (k + 1) * o.trials);
-        const std::string m = v::modal(c);
-        full_run &= m == "full";
-        hold_run &= m != "slide" && m != "topple" && m.find("slides") == std::string::npos;
-        if (full_run) l.full = deg[k];
-        if (hold_run) l.hold = deg[k];
-        if (m == "topple" && l.topple == 0) l.topple = deg[k];
-        if (l.topple == 0) l.upright = deg[k];
-        l.detail += fmt(deg[k], 0) + " deg: " + summary(c) + "; ";
+        modal.push_back(v::modal(c));
+        detail += fmt(deg[k], 0) + " deg: " + summary(c) + "; ";
       }
+      Limits l{two_sbots::slopeLimits(deg, modal), detail};
       return l;
     };
     const Limits ours = limitsFor(false), seed = limitsFor(true);
