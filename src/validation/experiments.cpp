@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <fstream>
 #include <map>
 #include <random>
@@ -255,7 +256,12 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial) {
     const Vec3 p = r.basePose().position;
     return p.x() > 0 ? std::hypot(p.x(), std::max(0.0, p.z() - z0)) : 0.0;
   };
+  // Do the tracks still turn? Mean encoder speed over the last 2 s relative to the command:
+  // separates "slipping" (tracks turn, no progress) from "stuck" (tracks stalled).
+  std::deque<double> track_ratio;
   runFor(w, (0.12 * s + 0.30 * s) / kSlowSpeed * 1.3 + 4.0, [&] {
+    track_ratio.push_back(0.5 * (std::fabs(r.trackSpeedLeft()) + std::fabs(r.trackSpeedRight())) / kSlowSpeed);
+    if (track_ratio.size() > 40) track_ratio.pop_front();
     const Vec3 up = upOf(r);
     if (angleBetween(up, Vec3::UnitZ()) > 100 * M_PI / 180 ||
         (r.basePose().position.x() > 0 && angleBetween(up, normal) > 75 * M_PI / 180)) {
@@ -270,9 +276,11 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial) {
   o.value = best;
   o.value2 = dh;
   if (o.label == "stuck") {
+    double turning = 0;
+    for (double t : track_ratio) turning += t / track_ratio.size();
     if (best > 0.03 * s && along() < best - 0.03 * s) o.label = "slide back";
-    else if (best > 0.05 * s) o.label = "slipping";
-    else if (dh > 0.35) o.label = "c/c";
+    else if (best <= 0.05 * s && dh > 0.35) o.label = "c/c";
+    else if (turning >= 0.5) o.label = "slipping";
   }
   return o;
 }

@@ -520,8 +520,9 @@ int main(int argc, char** argv) {
     });
     md << "## Table 4.6 - uphill slope per level at 2.8 cm/s (modal of " << o.trials << ")\n\n"
        << "The robot starts 12 cm before the foot of a ramp. climb: 25 cm up the slope; topple: over "
-          "backwards; slide back: got > 3 cm up and lost > 3 cm again; slipping: > 5 cm up but not 25 cm; "
-          "c/c: at the foot with its heading changed > 20 deg; stuck: at the foot.\n\n"
+          "backwards; slide back: got > 3 cm up and lost > 3 cm again; c/c: at the foot (< 5 cm up) with its "
+          "heading changed > 20 deg; slipping: short of 25 cm with its tracks still turning (encoders >= 50 % of the "
+          "command over the last 2 s); stuck: short of 25 cm with the tracks stalled.\n\n"
        << "| angle | level | seed | ours | match |\n|---|---|---|---|---|\n";
     for (std::size_t a = 0; a < ang.size(); ++a) {
       for (std::size_t l = 0; l < kLevels.size(); ++l) {
