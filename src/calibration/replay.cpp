@@ -23,7 +23,7 @@ namespace {
 class ContactProbe : public Effect {
  public:
   std::string name() const override { return "contact_probe"; }
-  void onContact(const ContactContext& c, dSurfaceParameters&) override {
+  void onContact(ContactContext& c, dSurfaceParameters&) override {
     const bool a_static = !c.robot_a, b_static = !c.robot_b;
     if ((c.robot_a && b_static && c.material_b != "ground") || (c.robot_b && a_static && c.material_a != "ground"))
       touching = true;

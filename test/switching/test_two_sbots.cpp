@@ -1,5 +1,5 @@
 // Decisive cells of the two-connected-s-bot rows (seed Table 4.1, 4.1.3) on the Detailed level:
-// the pair climbs fully at 29 deg and does not topple at 58 deg where a single s-bot topples; the
+// the pair climbs fully at 29 deg and (seed friction) does not topple at 58 deg where a single s-bot topples; the
 // pair passes a 32 mm step going backwards (the holder lifting itself with its gripper arm) where a
 // single s-bot going backwards fails.
 #include <gtest/gtest.h>
@@ -15,7 +15,10 @@ constexpr double kDeg = M_PI / 180;
 TEST(TwoSbots, SlopeRows) {
   EXPECT_EQ(two_sbots::pairSlope("detailed", 29 * kDeg, 0, true).label, "full");
   EXPECT_EQ(two_sbots::pairSlope("detailed", 58 * kDeg, 0, false).label, "topple");
-  EXPECT_NE(two_sbots::pairSlope("detailed", 58 * kDeg, 0, true).label, "topple");
+  // Stable at 58 deg: with the seed's friction set-up for this experiment (force limit 1.2 N per
+  // contact); Coulomb treels (mu 1) slide from 45 deg (the report's mismatch).
+  EXPECT_NE(two_sbots::pairSlope("detailed", 58 * kDeg, 0, true, true).label, "topple");
+  EXPECT_EQ(two_sbots::pairSlope("detailed", 58 * kDeg, 0, false, true).label, "topple");
 }
 
 TEST(TwoSbots, StepPassing32mm) {

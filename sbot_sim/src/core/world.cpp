@@ -252,10 +252,17 @@ void World::handlePair(dGeomID a, dGeomID b) {
   for (int i = 0; i < n; ++i) {
     ctx.normal = Vec3(contacts[i].geom.normal[0], contacts[i].geom.normal[1], contacts[i].geom.normal[2]);
     const Vec3 along = heading - heading.dot(ctx.normal) * ctx.normal;
-    ctx.fdir1 = along.norm() > 1e-9 ? Vec3(along.normalized()) : Vec3::Zero();
+    ctx.heading = along.norm() > 1e-9 ? Vec3(along.normalized()) : Vec3::Zero();
+    // ODE's friction pyramid (dContactApprox1) is a box in two friction directions. ODE's default
+    // directions are fixed in the world, so the same robot spun ~3 % faster heading 45 deg than
+    // heading 0; a robot's contacts with the terrain take its heading instead (body-fixed, as
+    // Gazebo's fdir1). (Slip-aligned directions would act as a Coulomb cone, but quickstep leaves
+    // ~1 cm/s of slip jitter at resting contacts.) Robot-robot contacts keep ODE's directions.
+    ctx.fdir1 = (!ba || !bb) ? ctx.heading : Vec3::Zero();
     contacts[i].surface = surface;
     for (const auto& e : effects_) e->onContact(ctx, contacts[i].surface);
-    if (contacts[i].surface.mode & dContactFDir1) {
+    if (ctx.fdir1.squaredNorm() > 0) {
+      contacts[i].surface.mode |= dContactFDir1;
       for (int k = 0; k < 3; ++k) contacts[i].fdir1[k] = ctx.fdir1[k];
     }
     dJointID c = dJointCreateContact(world_, contacts_, &contacts[i]);

@@ -2,6 +2,8 @@
 // connection registry, and the optical barrier.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 
 #include "sbot_sim/core/actuators/gripper.h"
@@ -152,6 +154,13 @@ TEST(ActuatorGripper, JawsConnectToTheRingAfterClosing) {
   ASSERT_TRUE(ga.gripping());
   EXPECT_EQ(ga.gripped(), "sbot_1");
   EXPECT_LE(ga.getAperture(), 10) << "closed on the ring: the jaws stop at its thickness";
+  int widest = 0;  // and stay there while connected (they used to bounce open to 14 deg)
+  for (int i = 0; i < 100; ++i) {
+    w.step();
+    ga.update(w.config().step);
+    widest = std::max(widest, ga.getAperture());
+  }
+  EXPECT_LE(widest, 10) << "the jaws hold on the ring";
   const double d0 = (b.basePose().position - a.basePose().position).norm();
   for (int i = 0; i < 100; ++i) {
     dBodyAddForce(b.baseBody(), 15.0, 0, 0);

@@ -48,11 +48,14 @@ TEST(ModelSwitch, StateIsCarriedOverExactlyAtTheSwitch) {
       // The wheels keep spinning at the track speed: measured speeds continue.
       EXPECT_NEAR(r.trackSpeedLeft(), 40 * 0.0028, 0.02) << from << "->" << to;
       EXPECT_NEAR(r.trackSpeedRight(), 30 * 0.0028, 0.02) << from << "->" << to;
-      // Physically continuous: one step later nothing jumped.
+      // Physically continuous: one step later nothing jumped. Vertically the new level may lose
+      // the old one's bobbing: Detailed's toothed wheels move its base up and down at up to
+      // 5 cm/s while driving (rms 0.7 cm/s), which smooth wheels do not carry on.
       w.step();
       const Snapshot next = snap(r);
       EXPECT_LT((next.base.position - after.base.position).norm(), 0.003) << from << "->" << to;
-      EXPECT_LT((next.v - after.v).norm(), 0.05) << from << "->" << to;
+      EXPECT_LT((next.v - after.v).head<2>().norm(), 0.03) << from << "->" << to;
+      EXPECT_LT(std::abs(next.v.z() - after.v.z()), 0.08) << from << "->" << to;
       EXPECT_NEAR(next.turret, after.turret, 0.02);
     }
   }
@@ -75,15 +78,18 @@ std::pair<Pose, double> driveSwitching(int left, int right, const std::vector<st
 }
 
 TEST(ModelSwitch, SwitchingToTheSameLevelDoesNotDisturbTheTrajectory) {
-  // The switch itself adds nothing: a curve with six basic->basic switches ends where the
-  // unswitched run ends.
+  // The switch itself adds almost nothing: a curve with six basic->basic switches ends near the
+  // unswitched run's end. Not exactly: the rebuilt bodies sit exactly where the joints say, while
+  // quickstep's unconverged joints had left them slightly off; one switch turns the robot's
+  // course by ~0.4 deg (1.5 mm after 5 s).
   const auto ref = driveSwitching(50, 35, {});
   const auto sw = driveSwitching(50, 35, {"basic"});
   const double err = (sw.first.position - ref.first.position).head<2>().norm();
-  std::printf("basic->basic x6 vs unswitched after 6 s: %.5f m\n", err);
+  const double yaw_err = test::wrapAngle(sw.first.yaw() - ref.first.yaw());
+  std::printf("basic->basic x6 vs unswitched after 6 s: %.5f m, %.2f deg\n", err, yaw_err * 180 / M_PI);
   EXPECT_LT(sw.second, 0.003);
-  EXPECT_LT(err, 0.005);
-  EXPECT_LT(std::abs(test::wrapAngle(sw.first.yaw() - ref.first.yaw())), 0.02);
+  EXPECT_LT(err, 0.01);
+  EXPECT_LT(std::abs(yaw_err), 0.035);
 }
 
 TEST(ModelSwitch, SwitchedRunFollowsTheUnswitchedTrajectory) {

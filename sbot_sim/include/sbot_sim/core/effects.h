@@ -35,9 +35,13 @@ struct ContactContext {
   const Robot* robot_b = nullptr;
   std::string material_a, material_b;
   Vec3 normal = Vec3::UnitZ();          ///< from b to a
-  /// First friction direction for anisotropic friction: the heading of the robot involved,
-  /// projected on the contact plane (zero when no robot is involved). An effect that sets
-  /// dContactFDir1 in surface.mode gets it copied into the contact.
+  /// Heading of the robot involved (a's if both), projected on the contact plane and normalised;
+  /// zero when no robot is involved.
+  Vec3 heading = Vec3::Zero();
+  /// First friction direction of ODE's friction pyramid: the robot's heading for robot-terrain
+  /// contacts (so that friction does not depend on the world axes), zero (ODE's default) for
+  /// robot-robot ones. Effects may change it and mu / mu2 in the surface; a non-zero value is
+  /// copied into the contact with dContactFDir1.
   Vec3 fdir1 = Vec3::Zero();
 };
 
@@ -55,7 +59,7 @@ class Effect {
   virtual ~Effect() = default;
   virtual std::string name() const = 0;
   virtual void onCommand(const Robot& /*robot*/, TrackCommand& /*cmd*/, double /*dt*/) {}
-  virtual void onContact(const ContactContext& /*ctx*/, dSurfaceParameters& /*surface*/) {}
+  virtual void onContact(ContactContext& /*ctx*/, dSurfaceParameters& /*surface*/) {}
   virtual void onSensor(const Robot& /*robot*/, SensorSample& /*sample*/) {}
   /// Forget any per-robot state (World::reset).
   virtual void reset() {}

@@ -191,12 +191,14 @@ void FrontGripper::update(double dt) {
     closing_ = false;
     return;
   }
-  // Jaws: each to aperture / 2.
+  // Jaws: each to aperture / 2, or held where they closed on the ring while connected.
   const double half = cmd_aperture_ * kDeg / 2.0;
+  jaws_holding_ = jaws_holding_ && gripping();
   double moving = 0;
   for (const std::string& jn : {jaw_upper_, jaw_lower_}) {
     dJointID j = robot_.hingeJoint(jn);
-    const double err = half - robot_.jointAngle(jn);
+    const double target = !jaws_holding_ ? half : jn == jaw_upper_ ? jaw_hold_upper_ : jaw_hold_lower_;
+    const double err = target - robot_.jointAngle(jn);
     dJointSetHingeParam(j, dParamVel, std::clamp(kServoGain * err, -jaw_speed_, jaw_speed_));
     dJointSetHingeParam(j, dParamFMax, jaw_torque_);
     moving = std::max(moving, std::abs(robot_.jointRate(jn)));
@@ -210,6 +212,9 @@ void FrontGripper::update(double dt) {
     if (reached || stall_time_ >= kStallTime || close_elapsed_ >= close_delay_ + kStallTime) {
       if (!gripping()) tryConnect();
       closing_ = false;
+      jaws_holding_ = gripping();
+      jaw_hold_upper_ = robot_.jointAngle(jaw_upper_);
+      jaw_hold_lower_ = robot_.jointAngle(jaw_lower_);
     }
   }
 }

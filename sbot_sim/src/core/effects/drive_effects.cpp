@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <type_traits>
 #include <utility>
 
 #include "sbot_sim/core/robot.h"
@@ -325,12 +324,6 @@ void RollingResistanceEffect::onCommand(const Robot& robot, TrackCommand& cmd, d
 
 // ---- track_friction_anisotropy -------------------------------------------------------------------
 
-namespace {
-template <class T, class = void>
-struct HasFdir1 : std::false_type {};
-template <class T>
-struct HasFdir1<T, std::void_t<decltype(std::declval<T&>().fdir1)>> : std::true_type {};
-}  // namespace
 
 TrackFrictionAnisotropyEffect::TrackFrictionAnisotropyEffect(const std::map<std::string, double>& p)
     : ParametricEffect(describe(), p) {}
@@ -347,39 +340,13 @@ EffectInfo TrackFrictionAnisotropyEffect::describe() {
           {{"lateral_ratio", "1", 1.0, 0.1, 3.0, 0.1, "lateral / longitudinal friction coefficient"}}};
 }
 
-bool TrackFrictionAnisotropyEffect::directionSupported() { return HasFdir1<ContactContext>::value; }
-
-namespace {
-// Sets the first friction direction when the core's ContactContext carries one (template, so the
-// branch that uses the member is only compiled when it exists).
-template <class Ctx>
-bool setFrictionDirection(Ctx& ctx, const Vec3& dir) {
-  if constexpr (HasFdir1<Ctx>::value) {
-    ctx.fdir1 = dir;
-    return true;
-  } else {
-    (void)ctx;
-    (void)dir;
-    return false;
-  }
-}
-}  // namespace
-
-void TrackFrictionAnisotropyEffect::onContact(const ContactContext& ctx, dSurfaceParameters& surface) {
-  if (!directionSupported()) return;
+void TrackFrictionAnisotropyEffect::onContact(ContactContext& ctx, dSurfaceParameters& surface) {
   const double ratio = param("lateral_ratio");
-  const Robot* robot = nullptr;
-  if (ctx.robot_a && ctx.material_a == "track") robot = ctx.robot_a;
-  else if (ctx.robot_b && ctx.material_b == "track") robot = ctx.robot_b;
-  if (!robot || ratio == 1.0) return;
-  // Track direction = robot heading projected onto the contact plane.
-  const Vec3 heading = robot->basePose().orientation * Vec3::UnitX();
-  Vec3 dir = heading - heading.dot(ctx.normal) * ctx.normal;
-  if (dir.norm() < 1e-6) return;
-  dir.normalize();
-  // World::handlePair's ctx is a local non-const object; fdir1 is the requested output member.
-  if (!setFrictionDirection(const_cast<ContactContext&>(ctx), dir)) return;
-  surface.mode |= dContactMu2 | dContactFDir1;
+  const bool track = (ctx.robot_a && ctx.material_a == "track") || (ctx.robot_b && ctx.material_b == "track");
+  if (!track || ratio == 1.0 || ctx.heading.squaredNorm() == 0) return;
+  // The pyramid's first direction along the track (the core's default on terrain), the second across.
+  ctx.fdir1 = ctx.heading;
+  surface.mode |= dContactMu2;
   surface.mu2 = surface.mu * ratio;
 }
 

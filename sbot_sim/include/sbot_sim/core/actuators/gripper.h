@@ -108,6 +108,11 @@ class FrontGripper {
   bool closing_ = false;       ///< a close command waits for the jaws (jaws) or the next update (sticky)
   double stall_time_ = 0;      ///< [s] jaws not moving while closing
   double close_elapsed_ = 0, close_delay_ = 0;  ///< [s] since the close command; jaw travel time
+  /// Jaws: once connected they hold the angles at which they closed on the ring [rad]; servoing on
+  /// towards 0 would press them against a ring that the rigid connection holds, and the 5 g jaws
+  /// then bounce (the aperture read 2-14 deg while gripping).
+  bool jaws_holding_ = false;
+  double jaw_hold_upper_ = 0, jaw_hold_lower_ = 0;
 };
 
 }  // namespace actuators

@@ -143,17 +143,13 @@ class RollingResistanceEffect : public ParametricEffect {
   void onCommand(const Robot& robot, TrackCommand& cmd, double dt) override;
 };
 
-/// Anisotropic track friction: along the track (robot heading) mu; across it lateral_ratio x mu.
+/// Anisotropic track friction: along the track (robot heading) mu, across it lateral_ratio x mu.
+/// lateral_ratio 1 is the core's friction exactly (its pyramid is aligned with the heading too).
 class TrackFrictionAnisotropyEffect : public ParametricEffect {
  public:
   explicit TrackFrictionAnisotropyEffect(const std::map<std::string, double>& p);
   static EffectInfo describe();
-  void onContact(const ContactContext& ctx, dSurfaceParameters& surface) override;
-  /// ODE takes the first friction direction from the dContact (fdir1), which effects.h does not
-  /// expose yet. When ContactContext gains a writable `fdir1` member (requested core change) the
-  /// effect sets it to the track direction; until then it is inert (anisotropy needs a direction:
-  /// ODE's default directions are fixed in the world, which would be a wrong, heading-dependent law).
-  static bool directionSupported();
+  void onContact(ContactContext& ctx, dSurfaceParameters& surface) override;
 };
 
 }  // namespace sbot
