@@ -9,13 +9,25 @@ Table 2.2 / sections 2.4 and 4.1 (1.2 N friction, measured by pulling an s-bot w
                          6 mm -> 1, 2 mm -> 25, 1 mm -> 100 (kind: place, z column)
   seed_traction/         the s-bot with passive tracks pulled forward by a force ramped 0 -> 2 N; it
                          stays put below 1.2 N (kind: drive with the force_x and passive inputs)
-Geometry from sbot_description/urdf/medium.urdf: ir_2 on the turret (joint origin 0.0086824,
-0.0492404 m, axis at 80 deg), turret at 4.7 cm above base_link, ground sensors 1 cm below base_link.
+Geometry is read from sbot_description/urdf/medium.urdf (ir_2 on the turret, the ground sensors
+below base_link), so the datasets follow the model; re-run after changing the parameter table.
 """
 import math
 import os
+import xml.etree.ElementTree as ET
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+URDF = os.path.join(HERE, "..", "sbot_description", "urdf", "medium.urdf")
+
+
+def joint_origin(name):
+    """(xyz, rpy) of a joint of the Medium URDF."""
+    for j in ET.parse(URDF).getroot().iter("joint"):
+        if j.get("name") == name:
+            o = j.find("origin")
+            return ([float(v) for v in o.get("xyz", "0 0 0").split()],
+                    [float(v) for v in o.get("rpy", "0 0 0").split()])
+    raise SystemExit("%s: no joint %s" % (URDF, name))
 
 
 def write(path, text):
@@ -27,7 +39,7 @@ def ir_response():
     d = os.path.join(HERE, "seed_ir_response")
     os.makedirs(d, exist_ok=True)
     wall_x = 1.0
-    sx0, sy0, axis = 0.0086824089, 0.049240388, math.radians(80)  # ir_2 in base_link (turret at 0)
+    (sx0, sy0, _), (_, _, axis) = joint_origin("ir_2_joint")  # turret frame; turret axis at x = y = 0
     yaw = -axis  # sensor axis along +x, toward the wall
     c, s = math.cos(yaw), math.sin(yaw)
     sx, sy = c * sx0 - s * sy0, s * sx0 + c * sy0
@@ -60,8 +72,12 @@ def ground_response():
     d = os.path.join(HERE, "seed_ground_response")
     os.makedirs(d, exist_ok=True)
     rows = ["x,y,yaw,z,ground0,ground1,ground2,ground3,_distance_mm"]
+    depths = {-joint_origin("ground_%d_joint" % k)[0][2] for k in range(4)}
+    if len(depths) != 1:
+        raise SystemExit("the ground sensors are not at one height below base_link: %s" % sorted(depths))
+    depth = depths.pop()
     for mm, reading in ((6, 1), (2, 25), (1, 100)):
-        z = mm / 1000.0 + 0.010  # base_link height: the sensors sit 1 cm below base_link
+        z = mm / 1000.0 + depth  # base_link height: the sensors sit `depth` below base_link
         rows.append("0,0,0,%.4f,%d,%d,%d,%d,%d" % (z, reading, reading, reading, reading, mm))
     write(os.path.join(d, "held_above_floor.csv"), "\n".join(rows) + "\n")
     write(os.path.join(d, "dataset.yaml"), """# sbot-dataset/1 -- the seed's ground sensor response points (sbot.h, Appendix A; section 2.2.7):
