@@ -12,6 +12,7 @@ and sent), and prints the real-time multiplier
 import argparse
 import os
 import re
+import signal
 import socket
 import subprocess
 import sys
@@ -52,7 +53,7 @@ def run(robots, seconds, scenario):
         exclude = os.environ.get('NODE_BENCH_EXCLUDE', '.*/camera/image_raw.*')
         recorder = subprocess.Popen(['rosbag', 'record', '-a', '-x', exclude, '-q',
                                      '-O', os.path.join(tmp, 'b.bag')],
-                                    env=env, stdout=devnull, stderr=devnull)
+                                    env=env, stdout=devnull, stderr=devnull, start_new_session=True)
         time.sleep(1.0)
         log_path = os.path.join(tmp, 'node.log')
         with open(log_path, 'w') as log:
@@ -63,7 +64,9 @@ def run(robots, seconds, scenario):
             while node.poll() is None:
                 peak = max(peak, peak_rss_mib(node.pid))
                 time.sleep(0.05)
-        recorder.terminate()
+        # `rosbag record` runs the recorder as a child process: interrupt the whole group (SIGINT
+        # closes the bag), or the child outlives the benchmark and loads the next rows.
+        os.killpg(recorder.pid, signal.SIGINT)
         recorder.wait()
         # The node's own summary times the stepping loop (start-up and spawning excluded).
         with open(log_path) as log:

@@ -286,8 +286,7 @@ int main(int argc, char** argv) {
         modal.push_back(v::modal(c));
         detail += fmt(deg[k], 0) + " deg: " + summary(c) + "; ";
       }
-      Limits l{two_sbots::slopeLimits(deg, modal), detail};
-      return l;
+      return Limits{two_sbots::slopeLimits(deg, modal), detail};
     };
     const Limits ours = limitsFor(false), seed = limitsFor(true);
     auto stableText = [&](const Limits& l) {

@@ -324,7 +324,6 @@ void RollingResistanceEffect::onCommand(const Robot& robot, TrackCommand& cmd, d
 
 // ---- track_friction_anisotropy -------------------------------------------------------------------
 
-
 TrackFrictionAnisotropyEffect::TrackFrictionAnisotropyEffect(const std::map<std::string, double>& p)
     : ParametricEffect(describe(), p) {}
 
