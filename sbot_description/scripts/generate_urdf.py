@@ -439,6 +439,7 @@ def build(level, p):
         "gear_ratio": tr["gear_ratio"],
         "rotor_inertia": tr["rotor_inertia_kgm2"],
         "backdrive_force": tr["friction_force_N"],
+        "torque_window": tr["torque_window_s"],
         "drive": tr.get("drive", "wheels"),
     }
     sc["turret"] = {"joint": "turret_joint", "speed": api["speed_rads"], "unit": api["unit_rad"],

@@ -239,6 +239,7 @@ def value_errors(u, sc, p, level):
     chk("sidecar torque_unit", sc["treels"]["torque_unit"], tr["torque_unit_Nm"])
     chk("sidecar speed_unit", sc["treels"]["speed_unit"], tr["speed_unit_mps"])
     chk("sidecar speed_limit_units", sc["treels"]["speed_limit_units"], tr["speed_limit_units"])
+    chk("sidecar torque_window", sc["treels"]["torque_window"], tr["torque_window_s"])
     chk("sidecar turret max_torque", sc["turret"]["max_torque"], api["max_torque_Nm"])
     chk("sidecar turret torque_unit", sc["turret"]["torque_unit"], api["torque_unit_Nm"])
     chk("sidecar turret unit", sc["turret"]["unit"], api["unit_rad"])

@@ -339,6 +339,7 @@ DiagnoseResult diagnose(const Dataset& ds, const DiagnoseOptions& opt, WorkerPoo
   };
   const std::size_t n_heldout = merge(cur_fold).n();
   out.heldout_rms_before = n_heldout ? std::sqrt(sumRss(cur_fold) / n_heldout) : 0;
+  out.heldout_before_by_channel = merge(cur_fold).byChannel(fo.eval.huber);
   std::vector<int> accepted_idx;  // indices into current.effects that were accepted here
   std::map<std::string, std::vector<std::string>> runners_up;  // accepted effect -> its step's rivals
   std::map<std::string, std::vector<double>> fold_estimates;    // "effect.param" -> per-fold values
@@ -706,6 +707,7 @@ DiagnoseResult diagnose(const Dataset& ds, const DiagnoseOptions& opt, WorkerPoo
   }
   out.final_model = current;
   out.heldout_rms_after = n_heldout ? std::sqrt(sumRss(cur_fold) / n_heldout) : 0;
+  out.heldout_after_by_channel = merge(cur_fold).byChannel(fo.eval.huber);
 
   // Residual structure of the final model (all runs, with features).
   EvalOptions eo = fo.eval;

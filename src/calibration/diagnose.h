@@ -10,6 +10,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -81,6 +82,7 @@ struct DiagnoseResult {
   /// the spread of the per-fold estimates.
   std::vector<double> interval95;
   double heldout_rms_before = 0, heldout_rms_after = 0;  ///< normalised held-out RMS
+  std::map<std::string, ChannelRss> heldout_before_by_channel, heldout_after_by_channel;  ///< the same, per channel
   std::vector<StructureNote> structure;   ///< of the final model's residuals
   bool structure_flagged = false;
   std::vector<std::pair<std::string, std::string>> ambiguous;  ///< (accepted, rival)

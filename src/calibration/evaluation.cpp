@@ -19,6 +19,18 @@ std::size_t Evaluation::n() const {
   return s;
 }
 
+std::map<std::string, ChannelRss> Evaluation::byChannel(double huber) const {
+  std::map<std::string, ChannelRss> out;
+  for (const auto& rr : runs)
+    for (std::size_t i = 0; i < rr.r.size(); ++i) {
+      if (!rr.valid[i]) continue;
+      ChannelRss& c = out[rr.channels[rr.chan[i]]];
+      c.rss += huberLoss(rr.r[i], huber);
+      ++c.n;
+    }
+  return out;
+}
+
 Eigen::VectorXd Evaluation::stacked() const {
   std::size_t len = 0;
   for (const auto& r : runs) len += r.r.size();

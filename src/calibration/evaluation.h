@@ -3,6 +3,8 @@
 // Channels can then be combined: a correct model gives a mean square of ~1 (the noise floor).
 #pragma once
 
+#include <cmath>
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -35,8 +37,17 @@ struct RunResiduals {
   RunPrediction prediction;           ///< kept when EvalOptions::replay.keep_trace
 };
 
+/// Robust sum of squared normalised residuals of one channel and its sample count.
+struct ChannelRss {
+  double rss = 0;
+  std::size_t n = 0;
+  double rmsNormalised() const { return n ? std::sqrt(rss / n) : 0.0; }
+};
+
 struct Evaluation {
   std::vector<RunResiduals> runs;
+  /// Per channel over all runs (channel name -> sums), with the Huber threshold the runs used.
+  std::map<std::string, ChannelRss> byChannel(double huber) const;
   double rss() const;
   std::size_t n() const;
   Eigen::VectorXd stacked() const;

@@ -195,16 +195,6 @@ RunPrediction replayDrive(World& world, const RobotDescription& d, const Dataset
   need_torque |= opt.keep_trace;
   need_tilt |= opt.keep_trace;
 
-  std::vector<int> left_idx, right_idx;
-  if (need_torque) {
-    const auto js = robot.jointStates();
-    for (std::size_t i = 0; i < js.size(); ++i) {
-      for (const auto& n : d.treels.left_joints)
-        if (js[i].name == n) left_idx.push_back(static_cast<int>(i));
-      for (const auto& n : d.treels.right_joints)
-        if (js[i].name == n) right_idx.push_back(static_cast<int>(i));
-    }
-  }
   const double su = d.treels.speed_unit, tu = d.treels.torque_unit;
   const int n = static_cast<int>(std::ceil(run.t_end / dt - 1e-9)) + 1;
   Trace tr;
@@ -256,12 +246,8 @@ RunPrediction replayDrive(World& world, const RobotDescription& d, const Dataset
       tr.speed_right.push_back(r.value / su);
     }
     if (need_torque) {
-      const auto js = robot.jointStates();
-      double tl = 0, trq = 0;
-      for (int i : left_idx) tl += js[i].effort;
-      for (int i : right_idx) trq += js[i].effort;
-      tr.torque_left.push_back(tl / tu);
-      tr.torque_right.push_back(trq / tu);
+      tr.torque_left.push_back(robot.trackTorqueLeft() / tu);
+      tr.torque_right.push_back(robot.trackTorqueRight() / tu);
     }
   };
 

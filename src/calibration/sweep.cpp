@@ -29,6 +29,26 @@ std::string pct(double f) {
   return o.str();
 }
 
+/// Channels where the starting model's held-out nRMS exceeds 1.2x the true model's: where `compare`
+/// shows the model failing. Their pooled before / after / floor go into `o`.
+void poolFailingChannels(const DiagnoseResult& r, const Evaluation& floor_eval, double huber, SeedOutcome& o) {
+  const auto floor = floor_eval.byChannel(huber);
+  ChannelRss before, after, fl;
+  for (const auto& [name, b] : r.heldout_before_by_channel) {
+    auto f = floor.find(name);
+    auto a = r.heldout_after_by_channel.find(name);
+    if (f == floor.end() || a == r.heldout_after_by_channel.end()) continue;
+    if (b.rmsNormalised() <= 1.2 * f->second.rmsNormalised()) continue;
+    o.failing_channels.push_back(name);
+    before.rss += b.rss, before.n += b.n;
+    after.rss += a->second.rss, after.n += a->second.n;
+    fl.rss += f->second.rss, fl.n += f->second.n;
+  }
+  o.failing_before = before.rmsNormalised();
+  o.failing_after = after.rmsNormalised();
+  o.failing_floor = fl.rmsNormalised();
+}
+
 }  // namespace
 
 void save(Writer& w, const SeedOutcome& o) {
@@ -39,6 +59,10 @@ void save(Writer& w, const SeedOutcome& o) {
   save(w, o.rms_before);
   save(w, o.rms_after);
   save(w, o.floor);
+  save(w, o.failing_channels);
+  save(w, o.failing_before);
+  save(w, o.failing_after);
+  save(w, o.failing_floor);
   save(w, o.structure_flagged);
   save(w, o.seconds);
   save(w, o.verdict);
@@ -51,6 +75,10 @@ void load(Reader& r, SeedOutcome& o) {
   load(r, o.rms_before);
   load(r, o.rms_after);
   load(r, o.floor);
+  load(r, o.failing_channels);
+  load(r, o.failing_before);
+  load(r, o.failing_after);
+  load(r, o.failing_floor);
   load(r, o.structure_flagged);
   load(r, o.seconds);
   load(r, o.verdict);
@@ -153,6 +181,7 @@ std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool) {
     eo.replay.tilt_direction = truth.tilt_direction;
     const Evaluation fl = evaluate(ds, ModelSpec{g.level, sc.hidden}, allRuns(ds), eo, pool);
     o.floor = fl.rmsNormalised();
+    poolFailingChannels(r, fl, eo.huber, o);
     if (opt.progress) {
       const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       std::string acc;
@@ -172,6 +201,10 @@ std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool) {
       const bool halved = o.rms_after <= 0.5 * o.rms_before;
       const bool floor_ok = o.rms_after <= 1.2 * o.floor;
       cs.at_floor += floor_ok / n;
+      // No failing channel: the starting model is already at the floor everywhere, nothing to halve.
+      const bool failing = !o.failing_channels.empty();
+      const bool failing_halved = failing && o.failing_after <= 0.5 * o.failing_before;
+      const bool failing_floor_ok = !failing || o.failing_after <= 1.2 * o.failing_floor;
       switch (cs.c.kind) {
         case SweepCase::Kind::Single: {
           const std::string& e = cs.c.hidden.front().name;
@@ -188,6 +221,8 @@ std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool) {
           }
           cs.params_within += within / n;
           cs.rmse_halved += halved / n;
+          cs.failing_halved += failing_halved / n;
+          cs.failing_at_floor += failing_floor_ok / n;
           break;
         }
         case SweepCase::Kind::None:
@@ -203,6 +238,8 @@ std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool) {
             both &= std::find(o.accepted.begin(), o.accepted.end(), h.name) != o.accepted.end();
           cs.both_found += both / n;
           cs.rmse_halved += halved / n;
+          cs.failing_halved += failing_halved / n;
+          cs.failing_at_floor += failing_floor_ok / n;
           break;
         }
       }
@@ -216,8 +253,9 @@ std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions&
   md << "Sweep: " << opt.seeds << " seeds per case, level " << opt.gen.level << " (unless the case names one), drive patterns of "
      << opt.gen.duration << " s, solver " << opt.gen.solver << ", " << opt.diag.folds << "-fold split by run, acceptance dBIC > "
      << opt.diag.bic_threshold << "; " << std::fixed << std::setprecision(0) << seconds << " s wall.\n\n";
-  md << "| hidden | truth | right first | params +-10 % | held-out RMS -50 % | ends <= 1.2x floor | nothing accepted | "
-        "structure flagged | both found | s/diagnose |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  md << "| hidden | truth | right first | params +-10 % | held-out RMS -50 % | ends <= 1.2x floor | failing channels -50 % | "
+        "failing channels <= 1.2x floor | nothing accepted | structure flagged | both found | s/diagnose |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& c : s) {
     std::ostringstream truth;
     for (const auto& h : c.c.hidden)
@@ -229,11 +267,16 @@ std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions&
     md << "| " << c.c.name << " | " << truth.str() << " | " << cell(c.c.kind == K::Single, c.right_first) << " | "
        << cell(c.c.kind == K::Single, c.params_within) << " | "
        << cell(c.c.kind == K::Single || c.c.kind == K::Pair, c.rmse_halved) << " | " << pct(c.at_floor) << " | "
+       << cell(c.c.kind == K::Single || c.c.kind == K::Pair, c.failing_halved) << " | "
+       << cell(c.c.kind == K::Single || c.c.kind == K::Pair, c.failing_at_floor) << " | "
        << cell(c.c.kind == K::None || c.c.kind == K::Outside, c.none_accepted) << " | "
        << cell(c.c.kind == K::Outside, c.flagged) << " | " << cell(c.c.kind == K::Pair, c.both_found) << " | "
        << std::setprecision(1) << c.mean_seconds << " |\n";
   }
-  md << "\nPer seed (accepted effects, held-out normalised RMS before -> after, noise floor):\n\n";
+  md << "\nFailing channels: those where the starting model's held-out nRMS exceeds 1.2x the true model's (what "
+        "`compare` shows failing); their residuals pooled.\n\n"
+        "Per seed (accepted effects, held-out normalised RMS before -> after (noise floor), the same on the failing "
+        "channels [which]):\n\n";
   for (const auto& c : s) {
     md << "- **" << c.c.name << "**: ";
     for (const auto& o : c.seeds) {
@@ -245,8 +288,13 @@ std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions&
         auto it = o.estimate.find(key);
         if (it != o.estimate.end()) md << key << "=" << std::setprecision(4) << it->second << " ";
       }
-      md << std::setprecision(2) << o.rms_before << "->" << o.rms_after << " (" << o.floor << ")"
-         << (o.structure_flagged ? " F" : "") << "; ";
+      md << std::setprecision(2) << o.rms_before << "->" << o.rms_after << " (" << o.floor << ")";
+      if (!o.failing_channels.empty()) {
+        std::string ch;
+        for (const auto& x : o.failing_channels) ch += (ch.empty() ? "" : ",") + x;
+        md << " failing " << o.failing_before << "->" << o.failing_after << " (" << o.failing_floor << ") [" << ch << "]";
+      }
+      md << (o.structure_flagged ? " F" : "") << "; ";
     }
     md << "\n";
   }

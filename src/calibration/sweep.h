@@ -29,6 +29,10 @@ struct SeedOutcome {
   std::vector<std::string> accepted;
   std::map<std::string, double> estimate, truth;  ///< "effect.param" -> value
   double rms_before = 0, rms_after = 0, floor = 0;  ///< held-out normalised RMS; noise floor (truth model)
+  /// The same three pooled over the channels where the starting model fails (its held-out nRMS on the
+  /// channel above 1.2x the true model's): the effect's signature, undiluted by channels it leaves alone.
+  std::vector<std::string> failing_channels;
+  double failing_before = 0, failing_after = 0, failing_floor = 0;
   bool structure_flagged = false;
   double seconds = 0;
   std::string verdict;
@@ -42,6 +46,8 @@ struct CaseSummary {
   double params_within = 0;    ///< single: its parameters within +-10 %
   double rmse_halved = 0;      ///< single: held-out RMS fell by >= 50 %
   double at_floor = 0;         ///< held-out RMS ends within 1.2x the noise floor
+  double failing_halved = 0;   ///< single/pair: on the failing channels, held-out RMS fell by >= 50 %
+  double failing_at_floor = 0; ///< single/pair: on the failing channels, it ends within 1.2x their floor
   double none_accepted = 0;    ///< none / outside: nothing accepted
   double flagged = 0;          ///< outside: residual structure flagged
   double both_found = 0;       ///< pair: both effects accepted

@@ -70,6 +70,19 @@ TEST(Generator, TrueModelSitsAtTheNoiseFloorAndTheNominalDoesNot) {
   EXPECT_LT(truth.rmsNormalised(), 1.25) << "tracker, encoder and inclinometer noise as declared";
   EXPECT_GT(truth.rmsNormalised(), 0.8);
   EXPECT_GT(nominal.rmsNormalised(), 1.8 * truth.rmsNormalised());
+
+  // Per channel (the sweep's "failing channels"): the sums add up to the whole, and a wrong wheel
+  // radius shows in the tracked position, not in the inclinometer.
+  const double h = EvalOptions().huber;
+  const auto tc = truth.byChannel(h), nc = nominal.byChannel(h);
+  double rss = 0;
+  std::size_t n = 0;
+  for (const auto& [name, c] : tc) rss += c.rss, n += c.n;
+  EXPECT_NEAR(rss, truth.rss(), 1e-9 * truth.rss());
+  EXPECT_EQ(n, truth.n());
+  ASSERT_TRUE(tc.count("x") && nc.count("x") && tc.count("pitch") && nc.count("pitch"));
+  EXPECT_GT(nc.at("x").rmsNormalised(), 1.5 * tc.at("x").rmsNormalised());
+  EXPECT_LT(nc.at("pitch").rmsNormalised(), 1.2 * tc.at("pitch").rmsNormalised());
 }
 
 // The seed's published sensor response points (Appendix A; datasets/make_seed_datasets.py places the

@@ -418,17 +418,18 @@ void Robot::getSpeed(int* left, int* right) const {
   if (right) *right = roundToUnits(trackSpeedRight() / unit, kApiLimit);
 }
 
+double Robot::trackTorqueLeft() const {
+  return torque_history_.empty() ? 0 : torque_sum_[0] / torque_history_.size();
+}
+
+double Robot::trackTorqueRight() const {
+  return torque_history_.empty() ? 0 : torque_sum_[1] / torque_history_.size();
+}
+
 void Robot::getTrackTorque(int* left, int* right) const {
-  auto sum = [this](const std::vector<int>& side) {
-    double t = 0;
-    for (int i : side) t += hinges_[i].effort;
-    return t;
-  };
   const double unit = description_->treels.torque_unit;
-  const double tl = drive_linear_ ? drive_torque_[0] : sum(left_hinges_);
-  const double tr = drive_linear_ ? drive_torque_[1] : sum(right_hinges_);
-  if (left) *left = roundToUnits(tl / unit, kApiLimit);
-  if (right) *right = roundToUnits(tr / unit, kApiLimit);
+  if (left) *left = roundToUnits(trackTorqueLeft() / unit, kApiLimit);
+  if (right) *right = roundToUnits(trackTorqueRight() / unit, kApiLimit);
 }
 
 bool Robot::setTurretRotation(int pos) {
@@ -591,7 +592,7 @@ void Robot::applyBodyDrive(const TrackCommand& cmd) {
   dJointSetAMotorParam(drive_angular_, dParamFMax, t_max);
 }
 
-void Robot::readFeedback() {
+void Robot::readFeedback(double dt) {
   for (auto& h : hinges_) {
     const double raw = dJointGetHingeAngle(h.id);
     h.angle += std::remainder(raw - h.raw_angle, 2 * M_PI);
@@ -611,6 +612,28 @@ void Robot::readFeedback() {
     const double r = description_->treels.wheel_radius;
     drive_torque_[0] = (0.5 * forward - yaw / track_width_) * r;
     drive_torque_[1] = (0.5 * forward + yaw / track_width_) * r;
+  }
+  auto sum = [this](const std::vector<int>& side) {
+    double t = 0;
+    for (int i : side) t += hinges_[i].effort;
+    return t;
+  };
+  const std::array<double, 2> now = drive_linear_ ? std::array<double, 2>{drive_torque_[0], drive_torque_[1]}
+                                                  : std::array<double, 2>{sum(left_hinges_), sum(right_hinges_)};
+  // The window's length in steps; rebuilt (and refilled from this step) if the step or the level changed.
+  const std::size_t n = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(description_->treels.torque_window / dt)));
+  if (torque_history_.size() != n) {
+    torque_history_.assign(n, now);
+    torque_sum_ = {now[0] * n, now[1] * n};
+    torque_next_ = 0;
+    return;
+  }
+  for (int s = 0; s < 2; ++s) torque_sum_[s] += now[s] - torque_history_[torque_next_][s];
+  torque_history_[torque_next_] = now;
+  torque_next_ = (torque_next_ + 1) % n;
+  if (torque_next_ == 0) {  // once per window: re-add, so rounding cannot accumulate over long runs
+    torque_sum_ = {0, 0};
+    for (const auto& h : torque_history_) torque_sum_[0] += h[0], torque_sum_[1] += h[1];
   }
 }
 

@@ -147,7 +147,9 @@ void parseSidecar(RobotDescription& d) {
   tr.gear_ratio = get<double>(t, "gear_ratio", tr.gear_ratio, file, "treels.");
   tr.rotor_inertia = get<double>(t, "rotor_inertia", tr.rotor_inertia, file, "treels.");
   tr.backdrive_force = get<double>(t, "backdrive_force", tr.backdrive_force, file, "treels.");
+  tr.torque_window = get<double>(t, "torque_window", tr.torque_window, file, "treels.");
   if (tr.rotor_inertia < 0) throw ConfigError(file, "treels.rotor_inertia", "must be >= 0");
+  if (!(tr.torque_window >= 0)) throw ConfigError(file, "treels.torque_window", "must be >= 0 [s]");
   tr.drive = get<std::string>(t, "drive", tr.drive, file, "treels.");
   if (tr.drive != "wheels" && tr.drive != "body")
     throw ConfigError(file, "treels.drive", "expected 'wheels' or 'body', found '" + tr.drive + "'");

@@ -211,7 +211,7 @@ void World::step() {
   else
     dWorldQuickStep(world_, dt);
   dJointGroupEmpty(contacts_);
-  for (auto& r : robots_) r->readFeedback();
+  for (auto& r : robots_) r->readFeedback(dt);
   time_ += dt;
   ++steps_;
 }

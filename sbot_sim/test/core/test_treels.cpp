@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include <cmath>
+#include <vector>
 
 #include "sbot_sim/core/errors.h"
 #include "sim_fixture.h"
@@ -136,6 +137,44 @@ TEST(Treels, HeldTracksStallAtMaximumTorque) {
     free_torque += 0.5 * (fl + fr) / 100.0;
   }
   EXPECT_LT(std::abs(free_torque), 20) << "mean torque on free ground [units]";
+}
+
+// getTrackTorque reports the mean motor torque over treels.torque_window (0.1 s), not one step's
+// constraint torque, which jitters with the contact solver (quickstep, six wheels).
+TEST(Treels, TrackTorqueIsTheMeanOverItsWindow) {
+  World w(flatWorld());
+  const RobotDescription d = loadLevel("medium");
+  Robot& r = w.addRobot(d, {0, 0, 0}, "sbot_0");
+  const int n = static_cast<int>(std::lround(d.treels.torque_window / w.config().step));
+  ASSERT_GT(n, 1);
+  r.setSpeed(40, 40);
+  runFor(w, 2.0);
+  std::vector<double> steps;  // per-step left-track torque [N m] from the joints' efforts
+  std::vector<double> readings;
+  for (int i = 0; i < 300; ++i) {
+    w.step();
+    double t = 0;
+    for (const auto& j : r.jointStates())
+      if (std::find(d.treels.left_joints.begin(), d.treels.left_joints.end(), j.name) != d.treels.left_joints.end())
+        t += j.effort;
+    steps.push_back(t);
+    if (steps.size() >= static_cast<std::size_t>(n)) {
+      double mean = 0;
+      for (int k = 0; k < n; ++k) mean += steps[steps.size() - 1 - k] / n;
+      ASSERT_NEAR(r.trackTorqueLeft(), mean, 1e-12) << "step " << i;
+    }
+    if (i % n == 0) readings.push_back(r.trackTorqueLeft() / d.treels.torque_unit);
+  }
+  auto sd = [](const std::vector<double>& v) {
+    double m = 0, s = 0;
+    for (double x : v) m += x / v.size();
+    for (double x : v) s += (x - m) * (x - m) / v.size();
+    return std::sqrt(s);
+  };
+  std::vector<double> step_units;
+  for (double t : steps) step_units.push_back(t / d.treels.torque_unit);
+  EXPECT_GT(sd(step_units), 2.0) << "the per-step torque jitters (if not, the window is not needed)";
+  EXPECT_LT(sd(readings), 0.5 * sd(step_units)) << "readings at 10 Hz, API units";
 }
 
 TEST(Treels, ApiRangeIsClampedThenLimitedTo70) {

@@ -55,6 +55,7 @@ struct TreelsSemantics {
   double gear_ratio = 150;           ///< motor to axle
   double rotor_inertia = 0;          ///< [kg m^2] of one track motor's rotor (reflected: x gear^2)
   double backdrive_force = 1.2;      ///< [N] to pull the whole robot with its motors off (passive)
+  double torque_window = 0.1;        ///< [s] getTrackTorque reports the mean motor torque over this window
   /// "wheels": a velocity motor on every driven hinge (wheel-ground contacts carry the robot);
   /// "body": the tracks drive the chassis directly as an ideal differential drive (Robot, Fast).
   std::string drive = "wheels";
