@@ -38,8 +38,9 @@ TEST(EffectsFile, ParsesAndInstantiates) {
   EXPECT_EQ(cfg[1].note, "fitted");
   const auto effects = makeEffects(cfg);
   ASSERT_EQ(effects.size(), 2u);
-  EXPECT_EQ(effects[1]->name(), "latency");
-  auto* p = dynamic_cast<ParametricEffect*>(effects[1].get());
+  EXPECT_EQ(effects[0]->name(), "latency") << "pipeline order (the registry's), not the file's";
+  EXPECT_EQ(effects[1]->name(), "speed_scale");
+  auto* p = dynamic_cast<ParametricEffect*>(effects[0].get());
   ASSERT_NE(p, nullptr);
   EXPECT_DOUBLE_EQ(p->param("delay"), 0.05);
   EXPECT_TRUE(parseEffectsConfig("", "empty.yaml").empty()) << "an empty file means no effects";

@@ -129,6 +129,20 @@ TEST(DriveEffects, TrackWidthAndSkidSlowSpins) {
   // Skid grows with the turn rate: a fast spin loses a larger fraction than a slow one.
   const std::vector<EffectConfig> skid{{"turn_skid", {{"k", 0.2}}, {}, ""}};
   const double slow = drive(skid, 20, -20, 2.0).turned / drive({}, 20, -20, 2.0).turned;
+// Effects do not commute; a world applies them in pipeline order, so an effects file is a set.
+TEST(DriveEffects, ListingOrderDoesNotChangeTheSimulation) {
+  const EffectConfig asymmetry{"motor_asymmetry", {{"asymmetry", 0.05}}, {}, ""};
+  const EffectConfig width{"track_width", {{"ratio", 1.5}}, {}, ""};
+  const Outcome a = drive({asymmetry, width}, 40, 40, 3.0);
+  const Outcome b = drive({width, asymmetry}, 40, 40, 3.0);
+  EXPECT_EQ(a.pose.x, b.pose.x);
+  EXPECT_EQ(a.pose.y, b.pose.y);
+  EXPECT_EQ(a.turned, b.turned);
+  // The motors' asymmetry comes before the ground's turn slip, which then divides its curve.
+  const Outcome alone = drive({asymmetry}, 40, 40, 3.0);
+  EXPECT_NEAR(a.turned, alone.turned / 1.5, 0.1 * std::abs(alone.turned / 1.5));
+}
+
   const double fast = drive(skid, 60, -60, 2.0).turned / drive({}, 60, -60, 2.0).turned;
   EXPECT_LT(slow, 0.95);
   EXPECT_LT(fast, slow - 0.05);

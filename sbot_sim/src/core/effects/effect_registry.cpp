@@ -67,6 +67,12 @@ const EffectInfo& EffectRegistry::info(const std::string& name) const {
   return entries_[it->second].info;
 }
 
+std::size_t EffectRegistry::position(const std::string& name) const {
+  auto it = index_.find(name);
+  if (it == index_.end()) throw UnknownName("unknown effect '" + name + "'");
+  return it->second;
+}
+
 std::vector<std::string> EffectRegistry::names() const {
   std::vector<std::string> out;
   for (const auto& e : entries_) out.push_back(e.info.name);

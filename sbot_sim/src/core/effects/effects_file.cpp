@@ -1,5 +1,6 @@
 #include "sbot_sim/core/effects/effects_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -95,11 +96,16 @@ std::vector<EffectConfig> loadEffectsConfig(const std::string& path) {
 }
 
 std::vector<EffectPtr> makeEffects(const std::vector<EffectConfig>& configs, const std::string& source) {
-  std::vector<EffectPtr> out;
+  std::vector<ParametricEffectPtr> out;
   const EffectRegistry& reg = EffectRegistry::instance();
   for (std::size_t i = 0; i < configs.size(); ++i)
     out.push_back(reg.create(configs[i].name, configs[i].params, source, "effects[" + std::to_string(i) + "]"));
-  return out;
+  // Pipeline order, not listing order: effects do not commute (a motor asymmetry applied before or
+  // after the turn slip of track_width differs by the width ratio), and a file is a set.
+  std::stable_sort(out.begin(), out.end(), [&](const ParametricEffectPtr& a, const ParametricEffectPtr& b) {
+    return reg.position(a->name()) < reg.position(b->name());
+  });
+  return {out.begin(), out.end()};
 }
 
 std::vector<EffectPtr> loadEffectsFile(const std::string& path) { return makeEffects(loadEffectsConfig(path), path); }

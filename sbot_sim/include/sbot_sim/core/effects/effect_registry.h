@@ -90,6 +90,8 @@ class EffectRegistry {
   bool has(const std::string& name) const { return index_.count(name) != 0; }
   const EffectInfo& info(const std::string& name) const;  ///< throws UnknownName
   std::vector<std::string> names() const;                   ///< registration order
+  /// Place of an effect in the pipeline (registration order); throws UnknownName.
+  std::size_t position(const std::string& name) const;
 
   /// Make an effect. Missing parameters take their null value. Throws ConfigError naming `source`
   /// and `field` (e.g. "effects[2]") for an unknown effect or parameter, a non-finite value or a

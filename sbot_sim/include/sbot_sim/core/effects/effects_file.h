@@ -28,7 +28,8 @@ struct EffectConfig {
 
 std::vector<EffectConfig> parseEffectsConfig(const std::string& yaml_text, const std::string& source);
 std::vector<EffectConfig> loadEffectsConfig(const std::string& path);
-/// Validate (names, parameters, bounds) and instantiate.
+/// Validate (names, parameters, bounds) and instantiate, in pipeline order (the registry's), not
+/// in the order listed.
 std::vector<EffectPtr> makeEffects(const std::vector<EffectConfig>& configs, const std::string& source = "<effects>");
 /// Read, validate and instantiate an effects file.
 std::vector<EffectPtr> loadEffectsFile(const std::string& path);
