@@ -236,14 +236,8 @@ RunPrediction replayDrive(World& world, const RobotDescription& d, const Dataset
       tr.roll.push_back(tilt_rpy.x());
     }
     if (need_speed) {
-      SensorSample l{kTrackSpeedChannel, 0, robot.trackSpeedLeft(), "", 0};
-      SensorSample r{kTrackSpeedChannel, 1, robot.trackSpeedRight(), "", 0};
-      for (const auto& e : world.effects()) {
-        e->onSensor(robot, l);
-        e->onSensor(robot, r);
-      }
-      tr.speed_left.push_back(l.value / su);
-      tr.speed_right.push_back(r.value / su);
+      tr.speed_left.push_back(robot.encoderSpeed(0) / su);
+      tr.speed_right.push_back(robot.encoderSpeed(1) / su);
     }
     if (need_torque) {
       tr.torque_left.push_back(robot.trackTorqueLeft() / tu);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "sbot_sim/core/effects/effect_registry.h"
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/world.h"
 
@@ -412,10 +413,16 @@ double Robot::trackSpeedRight() const {
   return right_hinges_.empty() ? 0 : sum / right_hinges_.size();
 }
 
+double Robot::encoderSpeed(int side) const {
+  SensorSample sample{kTrackSpeedChannel, side, side == 0 ? trackSpeedLeft() : trackSpeedRight(), "", 0};
+  for (const auto& e : world_.effects()) e->onSensor(*this, sample);
+  return sample.value;
+}
+
 void Robot::getSpeed(int* left, int* right) const {
   const double unit = description_->treels.speed_unit;
-  if (left) *left = roundToUnits(trackSpeedLeft() / unit, kApiLimit);
-  if (right) *right = roundToUnits(trackSpeedRight() / unit, kApiLimit);
+  if (left) *left = roundToUnits(encoderSpeed(0) / unit, kApiLimit);
+  if (right) *right = roundToUnits(encoderSpeed(1) / unit, kApiLimit);
 }
 
 double Robot::trackTorqueLeft() const {

@@ -57,10 +57,12 @@ bool SimRosInterface::readParams() {
   pnh_.param("publish_rate", params_.publish_rate, 50.0);
   pnh_.param("paused", params_.paused, false);
   pnh_.param("set_description_params", params_.set_description_params, false);
+  pnh_.param("effects", params_.effects, std::string());
   ROS_INFO("simulator: ~scenario=%s ~robots=%d ~real_time_factor=%g ~duration=%g ~publish_rate=%g ~paused=%s "
-           "~set_description_params=%s", params_.scenario.c_str(), params_.robots, params_.real_time_factor,
-           params_.duration, params_.publish_rate, params_.paused ? "true" : "false",
-           params_.set_description_params ? "true" : "false");
+           "~set_description_params=%s ~effects=%s", params_.scenario.c_str(), params_.robots,
+           params_.real_time_factor, params_.duration, params_.publish_rate, params_.paused ? "true" : "false",
+           params_.set_description_params ? "true" : "false",
+           params_.effects.empty() ? "(the scenario's)" : params_.effects.c_str());
   if (params_.robots < -1) {
     ROS_FATAL("simulator: ~robots must be -1 (the scenario's count) or >= 0, got %d", params_.robots);
     ok = false;
@@ -85,6 +87,7 @@ bool SimRosInterface::init() {
   if (!readParams()) return false;
   try {
     scenario_ = sbot::loadScenario(params_.scenario, params_.robots);
+    if (!params_.effects.empty()) scenario_.effects_file = params_.effects;
     world_ = buildWorld();
   } catch (const sbot::ConfigError& e) {
     ROS_FATAL("simulator: %s", e.what());
@@ -144,7 +147,12 @@ std::unique_ptr<sbot::World> SimRosInterface::buildWorld() const {
   sbot::swarm::addScenarioLinks(*world, scenario_.links);  // static links (seed 2.2.3)
   if (!scenario_.effects_file.empty()) {
     // The calibration workbench's effects file: throws ConfigError naming file and field.
-    for (const sbot::EffectPtr& e : sbot::loadEffectsFile(scenario_.effects_file)) world->addEffect(e);
+    std::string names;
+    for (const sbot::EffectPtr& e : sbot::loadEffectsFile(scenario_.effects_file)) {
+      world->addEffect(e);
+      names += (names.empty() ? "" : ", ") + e->name();
+    }
+    ROS_INFO("simulator: effects from %s: %s", scenario_.effects_file.c_str(), names.empty() ? "none" : names.c_str());
   }
   return world;
 }

@@ -35,6 +35,7 @@ struct NodeParams {
   double duration = 0;           ///< ~duration [s simulated]: 0 = the scenario's (0 there = unlimited)
   double publish_rate = 50;      ///< ~publish_rate [Hz sim]: ground truth, joint/track/turret state, tf
   bool paused = false;           ///< ~paused: start paused
+  std::string effects;           ///< ~effects: effects file (sbot_calibrate fit); replaces the scenario's `effects`
   /// ~set_description_params: also set <robot>/robot_description and <robot>/tf_prefix
   bool set_description_params = false;
 };

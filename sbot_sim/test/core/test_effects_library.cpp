@@ -17,7 +17,8 @@ struct Outcome {
   Pose2D pose;
   double turned = 0;         ///< integrated yaw change [rad]
   double torque_left = 0;    ///< mean API torque units over the last second
-  double encoder_left = 0;   ///< track speed [m/s] as the encoders read it (through onSensor)
+  double encoder_left = 0;   ///< track speed [m/s] as the encoders read it (Robot::encoderSpeed)
+  double api_left = 0;       ///< getSpeed's left reading [API units]
   std::vector<double> x;     ///< x every step
 };
 
@@ -44,14 +45,16 @@ Outcome drive(const std::vector<EffectConfig>& effects, int l, int r, double sec
       int tl, tr;
       robot.getTrackTorque(&tl, &tr);
       o.torque_left += tl;
-      SensorSample s{kTrackSpeedChannel, 0, robot.trackSpeedLeft(), "", 0};
-      for (const auto& e : w.effects()) e->onSensor(robot, s);
-      o.encoder_left += s.value;
+      o.encoder_left += robot.encoderSpeed(0);
+      int sl, sr;
+      robot.getSpeed(&sl, &sr);
+      o.api_left += sl;
       ++torque_n;
     }
   }
   o.torque_left /= std::max(1, torque_n);
   o.encoder_left /= std::max(1, torque_n);
+  o.api_left /= std::max(1, torque_n);
   const Pose p = robot.basePose();
   o.pose = {p.position.x(), p.position.y(), p.yaw()};
   return o;
@@ -64,7 +67,8 @@ TEST(EffectRegistry, EveryEffectHasConsistentParameterSpecs) {
   const auto names = reg.names();
   for (const char* required : {"speed_scale", "motor_asymmetry", "track_width", "turn_skid", "latency", "dead_band",
                                "motor_lag", "accel_limit", "torque_saturation", "rolling_resistance",
-                               "track_friction_anisotropy", "battery_sag"})
+                               "track_friction_anisotropy", "battery_sag", "ir_reflectance", "ir_incidence",
+                               "ir_ambient", "ir_gain_offset", "light_angular", "light_ambient"})
     EXPECT_TRUE(reg.has(required)) << required;
   for (const auto& n : names) {
     const EffectInfo& info = reg.info(n);
@@ -113,6 +117,9 @@ TEST(DriveEffects, SpeedScaleMovesTheGroundNotTheEncoders) {
   EXPECT_NEAR(distance(fast) / distance(base), 1.1, 0.02);
   EXPECT_NEAR(fast.encoder_left, base.encoder_left, 0.01 * std::abs(base.encoder_left))
       << "encoders read the commanded rotation";
+  // The API reading (getSpeed: controllers, the node's track_state) is that encoder, not the wheel
+  // rotation the scaled motor command produces (44 units).
+  EXPECT_NEAR(fast.api_left, 40, 1.0) << "getSpeed reads the encoder through the sensor-path effects";
 }
 
 TEST(DriveEffects, MotorAsymmetryCurvesAStraightCommand) {
@@ -122,13 +129,6 @@ TEST(DriveEffects, MotorAsymmetryCurvesAStraightCommand) {
   EXPECT_GT(right_strong.turned, 0.1);
 }
 
-TEST(DriveEffects, TrackWidthAndSkidSlowSpins) {
-  const Outcome base = drive({}, 40, -40, 2.0);
-  const Outcome wide = drive({{"track_width", {{"ratio", 1.25}}, {}, ""}}, 40, -40, 2.0);
-  EXPECT_NEAR(wide.turned / base.turned, 1 / 1.25, 0.03);
-  // Skid grows with the turn rate: a fast spin loses a larger fraction than a slow one.
-  const std::vector<EffectConfig> skid{{"turn_skid", {{"k", 0.2}}, {}, ""}};
-  const double slow = drive(skid, 20, -20, 2.0).turned / drive({}, 20, -20, 2.0).turned;
 // Effects do not commute; a world applies them in pipeline order, so an effects file is a set.
 TEST(DriveEffects, ListingOrderDoesNotChangeTheSimulation) {
   const EffectConfig asymmetry{"motor_asymmetry", {{"asymmetry", 0.05}}, {}, ""};
@@ -143,6 +143,13 @@ TEST(DriveEffects, ListingOrderDoesNotChangeTheSimulation) {
   EXPECT_NEAR(a.turned, alone.turned / 1.5, 0.1 * std::abs(alone.turned / 1.5));
 }
 
+TEST(DriveEffects, TrackWidthAndSkidSlowSpins) {
+  const Outcome base = drive({}, 40, -40, 2.0);
+  const Outcome wide = drive({{"track_width", {{"ratio", 1.25}}, {}, ""}}, 40, -40, 2.0);
+  EXPECT_NEAR(wide.turned / base.turned, 1 / 1.25, 0.03);
+  // Skid grows with the turn rate: a fast spin loses a larger fraction than a slow one.
+  const std::vector<EffectConfig> skid{{"turn_skid", {{"k", 0.2}}, {}, ""}};
+  const double slow = drive(skid, 20, -20, 2.0).turned / drive({}, 20, -20, 2.0).turned;
   const double fast = drive(skid, 60, -60, 2.0).turned / drive({}, 60, -60, 2.0).turned;
   EXPECT_LT(slow, 0.95);
   EXPECT_LT(fast, slow - 0.05);

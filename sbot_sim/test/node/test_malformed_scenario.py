@@ -74,6 +74,12 @@ class TestMalformedScenario(unittest.TestCase):
         path = self.fixture('three_robots.yaml')
         self.assertRefused(self.run_node('_scenario:=' + path, '_publish_rate:=-5.0'), '~publish_rate')
 
+    def test_effects_file_out_of_bounds(self):
+        scenario = self.fixture('three_robots.yaml')
+        effects = self.fixture('malformed.effects.yaml')
+        self.assertRefused(self.run_node('_scenario:=' + scenario, '_effects:=' + effects), effects,
+                           'effects[0].params.delay')
+
     def test_good_scenario_is_accepted(self):
         # Control: the same invocation with a valid scenario runs until its duration and exits 0.
         path = self.fixture('three_robots.yaml')

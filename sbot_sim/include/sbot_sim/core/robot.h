@@ -46,7 +46,7 @@ class Robot {
   /// then limited to +-speed_limit_units (70) as the seed's simulator does. Returns true if either
   /// value had to be changed.
   bool setSpeed(int left, int right);
-  /// Measured track speeds (wheel rotation), API units, in [-127,127].
+  /// Measured track speeds (encoderSpeed), API units, in [-127,127].
   void getSpeed(int* left, int* right) const;
   /// Track motor torques, API units (2.4412 mN m), in [-127,127]: trackTorqueLeft/Right.
   void getTrackTorque(int* left, int* right) const;
@@ -67,9 +67,13 @@ class Robot {
   void setTrackSpeeds(double left_mps, double right_mps);
   double requestedLeft() const { return req_left_; }
   double requestedRight() const { return req_right_; }
-  /// Measured track surface speeds [m/s] from wheel rotation.
+  /// Track surface speeds [m/s] from wheel rotation (the physics; no sensor effects).
   double trackSpeedLeft() const;
   double trackSpeedRight() const;
+  /// The wheel encoder's reading [m/s] of track `side` (0 left, 1 right): the wheel rotation passed
+  /// through the world's sensor-path effects (kTrackSpeedChannel), e.g. speed_scale's encoders read
+  /// the command while the ground moves faster. What getSpeed, the node and the calibration replay read.
+  double encoderSpeed(int side) const;
   /// Track motor torque [N m], the mean over the last treels.torque_window seconds: a motor's
   /// current reading averages, while one step's constraint torque carries the contact solver's
   /// step-to-step jitter (Medium, quickstep, 40 units: sd 4.8 API units per step, 0.6 over 0.1 s).

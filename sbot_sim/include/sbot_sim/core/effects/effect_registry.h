@@ -123,8 +123,8 @@ class PerRobot {
   std::map<std::string, State> states_;
 };
 
-/// Sensor channel name under which the calibration replay (and, once wired, Robot::getSpeed) passes
-/// the wheel-encoder track speeds [m/s] through Effect::onSensor (index 0 = left, 1 = right).
+/// Sensor channel name under which Robot::encoderSpeed (getSpeed, the node, the calibration replay)
+/// passes the wheel-encoder track speeds [m/s] through Effect::onSensor (index 0 = left, 1 = right).
 /// Slip effects use it so that the encoders read wheel rotation, not ground speed.
 inline const char* const kTrackSpeedChannel = "track_speed";
 
