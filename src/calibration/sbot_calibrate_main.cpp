@@ -6,7 +6,7 @@
 //   sbot_calibrate fit      DATASET --effect NAME [--effect NAME2 ...] [--effects BASE] --out FILE
 //   sbot_calibrate generate --out DIR [--level simple] [--seed N] [--hidden FILE] [--hide name:p=v,...]
 //                           [--tilt DEG] [--duration S] [--families a,b] [--repeat N] [--max-runs N]
-//   sbot_calibrate sweep    [--out FILE.md] [--seeds N] [--cases a,b] [--level L] [--duration S]
+//   sbot_calibrate sweep    [--out FILE.md] [--seeds N] [--cases a,b] [--level L] [--duration S] [--set name:p=v]
 //   sbot_calibrate effects  (list the effects library)
 //   common: --jobs N (worker processes, default: all cores), --quiet
 #include <chrono>
@@ -19,6 +19,7 @@
 #include <sstream>
 
 #include "calibration/diagnose.h"
+#include "calibration/effect_list.h"
 #include "calibration/generator.h"
 #include "calibration/report.h"
 #include "calibration/sweep.h"
@@ -82,37 +83,6 @@ Args parse(int argc, char** argv) {
   return a;
 }
 
-std::vector<std::string> split(const std::string& s, char sep) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  for (std::string x; std::getline(ss, x, sep);)
-    if (!x.empty()) out.push_back(x);
-  return out;
-}
-
-/// "speed_scale:scale=1.05,latency:delay=0.08" or "speed_scale:1.05" (single-parameter shorthand).
-std::vector<EffectConfig> parseHide(const std::string& spec) {
-  std::vector<EffectConfig> out;
-  for (const auto& item : split(spec, ';')) {
-    for (const auto& e : split(item, '+')) {
-      const auto colon = e.find(':');
-      EffectConfig c;
-      c.name = e.substr(0, colon);
-      const EffectInfo& info = EffectRegistry::instance().info(c.name);
-      if (colon != std::string::npos) {
-        for (const auto& kv : split(e.substr(colon + 1), ',')) {
-          const auto eq = kv.find('=');
-          if (eq == std::string::npos) c.params[info.params.front().name] = std::stod(kv);
-          else c.params[kv.substr(0, eq)] = std::stod(kv.substr(eq + 1));
-        }
-      }
-      out.push_back(c);
-    }
-  }
-  makeEffects(out, "--hide");  // validate
-  return out;
-}
-
 std::string pct(double v) {
   std::ostringstream o;
   o << std::fixed << std::setprecision(1) << v << " %";
@@ -129,6 +99,7 @@ void usage() {
                "           [--tilt DEG] [--duration S] [--families straight,spin,arc,square,steps] [--repeat N]\n"
                "           [--max-runs N] [--name NAME] [--torque] [--no-tilt] [--no-speed]\n"
                "  sweep    [--out FILE.md] [--seeds N] [--cases a,b] [--level L] [--solver S] [--duration S]\n"
+               "           [--set name:p=v+name2:p=v]  (another magnitude for the cases that hide those effects)\n"
                "  effects  list the effects library\n"
                "common options: --jobs N (worker processes; default all cores), --quiet\n");
 }
@@ -188,7 +159,7 @@ int cmdDiagnose(const Args& a) {
   o.folds = static_cast<int>(a.num("folds", 2));
   o.bic_threshold = a.num("threshold", 10);
   o.seed = static_cast<std::uint64_t>(a.num("seed", 1));
-  if (a.has("candidates")) o.candidates = split(a.get("candidates"), ',');
+  if (a.has("candidates")) o.candidates = splitList(a.get("candidates"), ',');
   o.progress = !a.has("quiet");
   if (a.has("verbose")) o.log = [](const std::string& s) { std::fprintf(stderr, "%s\n", s.c_str()); };
   WorkerPool& pool = WorkerPool::global();
@@ -235,7 +206,7 @@ int cmdFit(const Args& a) {
   ModelSpec m = baseModel(ds, a);
   std::vector<int> idx;
   for (const auto& n0 : names)
-    for (const auto& n : split(n0, ',')) {
+    for (const auto& n : splitList(n0, ',')) {
       EffectRegistry::instance().info(n);  // throws on unknown
       bool found = false;
       for (std::size_t i = 0; i < m.effects.size(); ++i)
@@ -292,10 +263,10 @@ int cmdGenerate(const Args& a) {
   g.measure_tilt = !a.has("no-tilt");
   g.measure_speed = !a.has("no-speed");
   if (a.has("families"))
-    for (const auto& f : split(a.get("families"), ',')) g.experiments.insert(f);
+    for (const auto& f : splitList(a.get("families"), ',')) g.experiments.insert(f);
   if (a.has("hidden")) g.hidden = loadEffectsConfig(a.get("hidden"));
   if (a.has("hide"))
-    for (const auto& e : parseHide(a.get("hide"))) g.hidden.push_back(e);
+    for (const auto& e : parseEffectList(a.get("hide"), "--hide")) g.hidden.push_back(e);
   const Dataset ds = generateDataset(g, WorkerPool::global());
   writeDataset(ds, a.get("out"));
   std::printf("wrote %s: %zu runs, %zu samples (level %s, seed %llu)\n", a.get("out").c_str(), ds.runs.size(),

@@ -1,6 +1,7 @@
 #include "calibration/sweep.h"
 
 #include "calibration/codec.h"
+#include "calibration/effect_list.h"
 
 #include <algorithm>
 #include <atomic>
@@ -15,18 +16,26 @@
 namespace sbot::calib {
 namespace {
 
-std::vector<std::string> split(const std::string& s, char sep) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  for (std::string x; std::getline(ss, x, sep);)
-    if (!x.empty()) out.push_back(x);
-  return out;
-}
-
 std::string pct(double f) {
   std::ostringstream o;
   o << std::fixed << std::setprecision(0) << 100 * f << " %";
   return o.str();
+}
+
+/// Every hidden parameter estimated within 10 % of its departure from null (e.g. speed scale 1.06
+/// +- 0.006). A hidden effect that was not accepted has no estimate and fails.
+bool paramsWithinTenPercent(const SeedOutcome& o) {
+  const EffectRegistry& reg = EffectRegistry::instance();
+  for (const auto& [key, tv] : o.truth) {
+    auto it = o.estimate.find(key);
+    const std::string effect = key.substr(0, key.find('.'));
+    const std::string pname = key.substr(key.find('.') + 1);
+    // specFor: open parameters (ir_reflectance's per-surface "<surface>") have a template spec.
+    const ParamSpec* spec = reg.info(effect).specFor(pname);
+    const double null = spec ? spec->null_value : 0.0;
+    if (it == o.estimate.end() || std::abs(it->second - tv) > 0.1 * std::abs(tv - null)) return false;
+  }
+  return true;
 }
 
 /// Channels where the starting model's held-out nRMS exceeds 1.2x the true model's: where `compare`
@@ -112,7 +121,11 @@ std::vector<SweepCase> standardCases(const std::string&) {
     c.push_back({e, {{e, {{p, v}}, {}, ""}}, 0, K::Single, "medium", {"place"}});
   };
   sensor("ir_reflectance", "black_card", 0.3);
-  sensor("ir_incidence", "exponent", 2.0);
+  // Exponent 4 (a glossy surface; Lambertian return is ~1): at 2 the law changes the starting model's
+  // held-out error only 1.7x the noise floor, so "falls by 50 %" cannot hold however well it is
+  // fitted (found first and within 10 % all the same: `sweep --cases ir_incidence --set
+  // ir_incidence:exponent=2`, docs/calibration.md "Detection limits").
+  sensor("ir_incidence", "exponent", 4.0);
   sensor("ir_ambient", "offset", 20.0);
   c.push_back({"none_ir", {}, 0, K::None, "medium", {"place"}});
   c.push_back({"none", {}, 0, K::None});
@@ -193,7 +206,6 @@ std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool) {
     return o;
   });
   for (std::size_t j = 0; j < jobs.size(); ++j) out[jobs[j].c].seeds[jobs[j].s] = outcomes[j];
-  const EffectRegistry& reg = EffectRegistry::instance();
   for (auto& cs : out) {
     const double n = std::max<std::size_t>(1, cs.seeds.size());
     for (const auto& o : cs.seeds) {
@@ -210,15 +222,7 @@ std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool) {
           const std::string& e = cs.c.hidden.front().name;
           const bool first = !o.accepted.empty() && o.accepted.front() == e;
           cs.right_first += first / n;
-          bool within = first;
-          for (const auto& [key, tv] : o.truth) {
-            auto it = o.estimate.find(key);
-            const std::string pname = key.substr(key.find('.') + 1);
-            // specFor: open parameters (ir_reflectance's per-surface "<surface>") have a template spec.
-            const ParamSpec* spec = reg.info(e).specFor(pname);
-            const double null = spec ? spec->null_value : 0.0;
-            within &= it != o.estimate.end() && std::abs(it->second - tv) <= 0.1 * std::abs(tv - null);
-          }
+          const bool within = first && paramsWithinTenPercent(o);
           cs.params_within += within / n;
           cs.rmse_halved += halved / n;
           cs.failing_halved += failing_halved / n;
@@ -237,6 +241,7 @@ std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool) {
           for (const auto& h : cs.c.hidden)
             both &= std::find(o.accepted.begin(), o.accepted.end(), h.name) != o.accepted.end();
           cs.both_found += both / n;
+          cs.params_within += (both && paramsWithinTenPercent(o)) / n;
           cs.rmse_halved += halved / n;
           cs.failing_halved += failing_halved / n;
           cs.failing_at_floor += failing_floor_ok / n;
@@ -265,7 +270,7 @@ std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions&
     using K = SweepCase::Kind;
     auto cell = [&](bool show, double v) { return show ? pct(v) : std::string("-"); };
     md << "| " << c.c.name << " | " << truth.str() << " | " << cell(c.c.kind == K::Single, c.right_first) << " | "
-       << cell(c.c.kind == K::Single, c.params_within) << " | "
+       << cell(c.c.kind == K::Single || c.c.kind == K::Pair, c.params_within) << " | "
        << cell(c.c.kind == K::Single || c.c.kind == K::Pair, c.rmse_halved) << " | " << pct(c.at_floor) << " | "
        << cell(c.c.kind == K::Single || c.c.kind == K::Pair, c.failing_halved) << " | "
        << cell(c.c.kind == K::Single || c.c.kind == K::Pair, c.failing_at_floor) << " | "
@@ -318,7 +323,7 @@ int runSweepCommand(const std::multimap<std::string, std::string>& opts, const s
   o.progress = !flags.count("quiet");
   auto all = standardCases(o.gen.level);
   if (opts.count("cases")) {
-    for (const auto& name : split(get("cases", ""), ',')) {
+    for (const auto& name : splitList(get("cases", ""), ',')) {
       bool found = false;
       for (const auto& c : all)
         if (c.name == name) {
@@ -329,6 +334,20 @@ int runSweepCommand(const std::multimap<std::string, std::string>& opts, const s
     }
   } else {
     o.cases = all;
+  }
+  // --set effect:param=value: another magnitude for the selected cases that hide that effect (how
+  // small an effect diagnose still finds; the standard magnitudes are in standardCases).
+  if (opts.count("set")) {
+    for (const auto& over : parseEffectList(get("set", ""), "--set")) {
+      bool used = false;
+      for (auto& c : o.cases)
+        for (auto& h : c.hidden)
+          if (h.name == over.name) {
+            for (const auto& [k, v] : over.params) h.params[k] = v;
+            used = true;
+          }
+      if (!used) throw std::invalid_argument("--set " + over.name + ": no selected sweep case hides that effect");
+    }
   }
   const auto t0 = std::chrono::steady_clock::now();
   const auto res = runSweep(o, WorkerPool::global());
