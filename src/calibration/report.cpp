@@ -14,6 +14,11 @@
 namespace sbot::calib {
 namespace {
 
+/// NRMSE fit [%] = 100 (1 - |y - yhat| / |y - mean(y)|) from the two sums of squares; NaN for a flat y.
+double nrmseFit(double ss_residual, double ss_measured) {
+  return ss_measured > 0 ? 100 * (1 - std::sqrt(ss_residual / ss_measured)) : std::numeric_limits<double>::quiet_NaN();
+}
+
 void mkdirs(const std::string& path) {
   std::string cur;
   std::stringstream ss(path);
@@ -113,7 +118,9 @@ VariantSummary summarise(const Dataset& ds, const Evaluation& ev, const std::str
       } else {
         cm.rmse = std::sqrt(ss_raw / cm.n);
         cm.nrms = std::sqrt(ss_r / cm.n);
-        cm.fit = ss_y > 0 ? 100 * (1 - std::sqrt(ss_raw / ss_y)) : std::numeric_limits<double>::quiet_NaN();
+        cm.ss_residual = ss_raw;
+        cm.ss_measured = ss_y;
+        cm.fit = nrmseFit(ss_raw, ss_y);
         const std::string g = NoiseModel::group(c);
         gn[g].first += ss_r;
         gn[g].second += cm.n;
@@ -281,9 +288,9 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
     }
   if (sensors && !sums.empty()) {
     md << "## Per sensor (all runs)\n\n| sensor |";
-    for (const auto& s : sums) md << " RMSE " << s.label << " | nRMS " << s.label << " |";
+    for (const auto& s : sums) md << " RMSE " << s.label << " | fit % " << s.label << " | nRMS " << s.label << " |";
     md << "\n|---|";
-    for (std::size_t i = 0; i < sums.size(); ++i) md << "---|---|";
+    for (std::size_t i = 0; i < sums.size(); ++i) md << "---|---|---|";
     md << "\n";
     std::set<std::string> chans;
     for (const auto& c : sums.front().channels) {
@@ -293,15 +300,18 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
     for (const auto& ch : chans) {
       md << "| " << ch << " |";
       for (const auto& s : sums) {
-        double a = 0, b = 0;
+        double a = 0, b = 0, ss_res = 0, ss_meas = 0;
         std::size_t n = 0;
         for (const auto& c : s.channels)
           if (c.channel == ch && c.n) {
             a += c.rmse * c.rmse * c.n;
             b += c.nrms * c.nrms * c.n;
+            ss_res += c.ss_residual;
+            ss_meas += c.ss_measured;  // about each run's mean: the variation within runs explained
             n += c.n;
           }
-        md << " " << (n ? f(std::sqrt(a / n)) : "n/a") << " | " << (n ? f(std::sqrt(b / n), 3) : "n/a") << " |";
+        md << " " << (n ? f(std::sqrt(a / n)) : "n/a") << " | " << (n ? fixed(nrmseFit(ss_res, ss_meas), 1) : "n/a")
+           << " | " << (n ? f(std::sqrt(b / n), 3) : "n/a") << " |";
       }
       md << "\n";
     }

@@ -15,6 +15,7 @@ struct ChannelMetrics {
   double rmse = 0;       ///< channel units
   double fit = 0;        ///< NRMSE fit [%] = 100 (1 - |y - yhat| / |y - mean(y)|)
   double nrms = 0;       ///< normalised RMS (noise floor ~ 1)
+  double ss_residual = 0, ss_measured = 0;  ///< sum (y - yhat)^2, sum (y - mean(y))^2: fits pool over runs
 };
 
 struct VariantSummary {

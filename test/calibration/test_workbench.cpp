@@ -157,5 +157,37 @@ TEST(Compare, WritesTablesPlotsAndTheWaterfall) {
     EXPECT_EQ(::stat((co.out_dir + "/plots/" + png).c_str(), &st), 0) << png << " (plot_report.py)";
 }
 
+TEST(Compare, SensorRunsGetThePerSensorTableAndFeaturePlot) {
+  GeneratorOptions g;
+  g.seed = 23;
+  g.level = "medium";  // ray-traced IR
+  g.experiments = {"place"};
+  g.hidden = {{"ir_incidence", {{"exponent", 4.0}}, {}, ""}};
+  const Dataset ds = generateDataset(g, WorkerPool::global());
+  CompareOptions co;
+  co.out_dir = testing::TempDir() + "sbot_compare_sensor_report";
+  const auto sums = writeCompareReport(
+      ds, {{"nominal", {ds.robot, {}}}, {"+incidence", {ds.robot, g.hidden}}}, co, WorkerPool::global());
+  ASSERT_EQ(sums.size(), 2u);
+  std::ifstream md(co.out_dir + "/report.md");
+  std::stringstream text;
+  text << md.rdbuf();
+  const std::string report = text.str();
+  const auto table = report.find("## Per sensor (all runs)");
+  ASSERT_NE(table, std::string::npos);
+  EXPECT_NE(report.find("| RMSE nominal | fit % nominal | nRMS nominal |", table), std::string::npos);
+  // ir0's row: RMSE, fit %, nRMS for both variants; the fit is a number, and better with the effect.
+  const auto row = report.find("| ir0 |", table);
+  ASSERT_NE(row, std::string::npos);
+  std::vector<std::string> cells;
+  std::stringstream line(report.substr(row + 1, report.find('\n', row) - row - 1));
+  for (std::string c; std::getline(line, c, '|');) cells.push_back(c);
+  ASSERT_GE(cells.size(), 7u) << report.substr(row, 200);
+  const double fit_nominal = std::stod(cells[2]), fit_effect = std::stod(cells[5]);
+  EXPECT_GT(fit_effect, fit_nominal) << report.substr(row, 200);
+  struct stat st;
+  EXPECT_EQ(::stat((co.out_dir + "/plots/sensor_features.png").c_str(), &st), 0) << "plot_report.py";
+}
+
 }  // namespace
 }  // namespace sbot::calib
