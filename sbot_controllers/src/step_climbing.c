@@ -25,13 +25,9 @@
  * holder stopping at the step) through its own tracks. LEDs show the phase (blue approaching, yellow
  * lifting, green done, red gave up or toppled).
  */
-#include <math.h>
-#include <signal.h>
-#include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
-#include "sbot.h"
+#include "example_common.h"
 
 #define REVERSE (-15)       /* [track units] about 4.2 cm/s backwards */
 #define CREEP 5             /* [track units] forward while gripping */
@@ -55,10 +51,6 @@
 #define START_S 8.0         /* [s] both robots start reversing together (gripping takes ~5.5 s) */
 #define TIMEOUT_S 60.0      /* [s] give up */
 
-static volatile sig_atomic_t running = 1;
-static void onSignal(int s) { (void)s; running = 0; }
-static void onError(const char *text) { fprintf(stderr, "[step_climbing] error: %s\n", text); }
-static void onWarning(const char *text) { fprintf(stderr, "[step_climbing] warning: %s\n", text); }
 
 static void leds(unsigned r, unsigned g, unsigned b) { setSameLightColor(r, g, b, BLINKING_RATE_NO_BLINK); }
 
@@ -285,9 +277,7 @@ int main(int argc, char **argv) {
   }
   role_name = role;
   setvbuf(stdout, NULL, _IOLBF, 0);
-  initSwarmBot(onError, onWarning);
-  signal(SIGINT, onSignal);
-  signal(SIGTERM, onSignal);
+  startController("step_climbing");
   setSlopeSamplingRate(SAMPLING_RATE_10);
   if (strcmp(role, "holder") == 0) holder();
   else if (strcmp(role, "held") == 0) held();
