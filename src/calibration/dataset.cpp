@@ -255,7 +255,13 @@ void parseRunCsv(const std::string& text, const std::string& file, Run& run) {
     col[h] = static_cast<int>(i);
   }
   auto need = [&](const std::string& c) {
-    if (!col.count(c)) throw DatasetError(file, header_line, 0, c, "missing column '" + c + "'");
+    if (col.count(c)) return;
+    std::string have;
+    for (const auto& h : header) have += (have.empty() ? "" : ", ") + h;
+    throw DatasetError(file, header_line, 0, c,
+                       "missing column '" + c + "' (a " + (run.kind == RunKind::Drive ? "drive" : "place") +
+                           " run needs " + (run.kind == RunKind::Drive ? "t, cmd_left, cmd_right" : "x, y, yaw") +
+                           "; the header has " + have + ")");
   };
   const bool drive = run.kind == RunKind::Drive;
   if (drive) {

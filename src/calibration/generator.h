@@ -22,8 +22,9 @@ struct GeneratorOptions {
   std::vector<EffectConfig> hidden;        ///< effects switched on in the "real" robot
   double tilt_deg = 0;                     ///< hidden floor tilt [deg] (not in the library)
   double duration = 8;                     ///< [s] length of each drive pattern
-  /// Experiment families: straight, spin, arc, square, steps (drive); wall (IR approaches, needs
-  /// sensor modules); place (static IR placements). Empty = the drive families.
+  /// Experiment families: straight, spin, arc, square, steps (drive runs); place (the IR wall
+  /// approaches as static placements: three surfaces, incidence 0-60 deg, 1-16 cm). Empty = the
+  /// drive families.
   std::set<std::string> experiments;
   int repeat = 1;                          ///< repeat the drive set (more runs)
   std::size_t max_runs = 0;                ///< 0 = all

@@ -117,6 +117,8 @@ TEST(Dataset, MissingColumnNamesFileAndColumn) {
   EXPECT_NE(e.file().find("straight.csv"), std::string::npos);
   EXPECT_EQ(e.columnName(), "cmd_right");
   EXPECT_EQ(e.line(), 1);
+  EXPECT_NE(std::string(e.what()).find("straight.csv:1 (column 'cmd_right')"), std::string::npos) << e.what();
+  EXPECT_NE(std::string(e.what()).find("the header has t, cmd_left, x"), std::string::npos) << e.what();
 }
 
 TEST(Dataset, NonMonotonicTimeNamesLineAndColumn) {
