@@ -507,9 +507,16 @@ DiagnoseResult diagnose(const Dataset& ds, const DiagnoseOptions& opt, WorkerPoo
       break;
     }
     rd.accepted = best.effect;
-    for (std::size_t i = 1; i < rd.ranked.size(); ++i)
-      if (rd.ranked[i].passes && rd.ranked[i].delta_bic > best.delta_bic - opt.ambiguity_margin)
-        rd.indistinguishable.push_back(rd.ranked[i].effect);
+    // A rival is indistinguishable when the evidence barely separates them, or when its held-out
+    // error is within the simulation's resolution of the best's (min_reduction: below that the
+    // difference is the replay's chaos, which BIC would count as evidence: on cruise-only data a
+    // speed scale and a dead-band swap places from seed to seed with dBIC gaps up to 130).
+    for (std::size_t i = 1; i < rd.ranked.size(); ++i) {
+      const CandidateScore& rival = rd.ranked[i];
+      const bool close_evidence = rival.delta_bic > best.delta_bic - opt.ambiguity_margin;
+      const bool close_error = rival.cv_rss <= (1 + opt.min_reduction) * best.cv_rss;
+      if (rival.passes && (close_evidence || close_error)) rd.indistinguishable.push_back(rival.effect);
+    }
     for (const auto& r : rd.indistinguishable) out.ambiguous.push_back({best.effect, r});
     out.accepted.push_back(best.effect);
     for (std::size_t j = 0; j < best.params.size(); ++j)

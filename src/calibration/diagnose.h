@@ -24,7 +24,9 @@ struct DiagnoseOptions {
   /// Minimum held-out RSS reduction for acceptance. The simulation is slightly chaotic: the same
   /// model with parameters a hair apart differs by 1-2 % in held-out RSS, so smaller gains are noise.
   double min_reduction = 0.05;
-  double ambiguity_margin = 6;    ///< candidates within this dBIC of the best are "indistinguishable"
+  /// Candidates within this dBIC of the best, or whose held-out RSS is within min_reduction of the
+  /// best's, are "indistinguishable" (reported with the experiment that would separate them).
+  double ambiguity_margin = 6;
   int max_effects = 4;
   int screen_iterations = 2;      ///< LM iterations when screening every candidate
   int finalists = 3;              ///< candidates refined to convergence per step
