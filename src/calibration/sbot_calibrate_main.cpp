@@ -8,7 +8,8 @@
 //                           [--tilt DEG] [--duration S] [--families a,b] [--repeat N] [--max-runs N]
 //   sbot_calibrate sweep    [--out FILE.md] [--seeds N] [--cases a,b] [--level L] [--duration S] [--set name:p=v]
 //   sbot_calibrate effects  (list the effects library)
-//   common: --jobs N (worker processes, default: all cores), --quiet
+//   common: --jobs N (worker processes, default: all cores), --quiet; compare/diagnose/fit also
+//           --solver quickstep|exact (replaces the dataset's world stepper)
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -101,7 +102,20 @@ void usage() {
                "  sweep    [--out FILE.md] [--seeds N] [--cases a,b] [--level L] [--solver S] [--duration S]\n"
                "           [--set name:p=v+name2:p=v]  (another magnitude for the cases that hide those effects)\n"
                "  effects  list the effects library\n"
-               "common options: --jobs N (worker processes; default all cores), --quiet\n");
+               "common options: --jobs N (worker processes; default all cores), --quiet;\n"
+               "  compare/diagnose/fit: --solver quickstep|exact replaces the dataset's world stepper\n");
+}
+
+/// The dataset, with --solver replacing its world's stepper (quickstep | exact): whether a misfit is
+/// the model's physics or quickstep's non-convergence, without editing the dataset.
+Dataset datasetFor(const Args& a) {
+  Dataset ds = loadDataset(a.positional[0]);
+  if (a.has("solver")) {
+    const std::string s = a.get("solver");
+    if (s != "quickstep" && s != "exact") throw std::invalid_argument("--solver expects quickstep or exact, got '" + s + "'");
+    ds.world.solver = s;
+  }
+  return ds;
 }
 
 ModelSpec baseModel(const Dataset& ds, const Args& a) {
@@ -125,7 +139,7 @@ int cmdEffects() {
 
 int cmdCompare(const Args& a) {
   if (a.positional.empty()) throw std::invalid_argument("compare needs a DATASET");
-  const Dataset ds = loadDataset(a.positional[0]);
+  const Dataset ds = datasetFor(a);
   ModelSpec nominal{a.has("level") ? a.get("level") : ds.robot, {}};
   std::vector<std::pair<std::string, ModelSpec>> variants{{"nominal", nominal}};
   if (a.has("effects")) {
@@ -153,7 +167,7 @@ int cmdCompare(const Args& a) {
 
 int cmdDiagnose(const Args& a) {
   if (a.positional.empty()) throw std::invalid_argument("diagnose needs a DATASET");
-  const Dataset ds = loadDataset(a.positional[0]);
+  const Dataset ds = datasetFor(a);
   DiagnoseOptions o;
   o.base = baseModel(ds, a);
   o.folds = static_cast<int>(a.num("folds", 2));
@@ -202,7 +216,7 @@ int cmdFit(const Args& a) {
   const auto names = a.all("effect");
   if (names.empty()) throw std::invalid_argument("fit needs --effect NAME");
   if (!a.has("out")) throw std::invalid_argument("fit needs --out FILE (the effects file to write)");
-  const Dataset ds = loadDataset(a.positional[0]);
+  const Dataset ds = datasetFor(a);
   ModelSpec m = baseModel(ds, a);
   std::vector<int> idx;
   for (const auto& n0 : names)

@@ -10,6 +10,7 @@
 #include "calibration/evaluation.h"
 #include "calibration/fit.h"
 #include "calibration/generator.h"
+#include "calibration/replay.h"
 #include "calibration/report.h"
 
 namespace sbot::calib {
@@ -95,6 +96,30 @@ TEST(SeedDatasets, SensorResponsePointsAreReproduced) {
     EXPECT_GT(e.n(), 3u) << name;
     EXPECT_LT(e.rmsNormalised(), 1.0) << name;
   }
+}
+
+// The seed's traction measurement (a passive s-bot pulled with a force ramped 0 -> 2 N does not move
+// below 1.2 N) is reproduced by the model with the exact solver: it holds within the tracker noise
+// and breaks away above 1.2 N. With quickstep it creeps and turns (docs/calibration.md, README
+// "Known flaw: yaw drift"); this test pins the physics, not that solver artefact.
+TEST(SeedDatasets, TractionIsReproducedWithTheExactSolver) {
+  Dataset ds = loadDataset(std::string(SWARMBOT3D_SOURCE_DIR) + "/datasets/seed_traction");
+  ds.world.solver = "exact";
+  const Evaluation e = evaluate(ds, {ds.robot, {}}, allRuns(ds), EvalOptions(), WorkerPool::global());
+  EXPECT_GT(e.n(), 30u);
+  EXPECT_LT(e.rmsNormalised(), 1.0) << "held below 1.2 N";
+  ReplayOptions ro;
+  ro.keep_trace = true;
+  ro.align = false;
+  const RunPrediction p = replayRun(ds, ds.runs.at(0), {ds.robot, {}}, ro);
+  ASSERT_FALSE(p.trace.t.empty());
+  double x_at_1_2N = 0, x_at_1_8N = 0;  // the force ramps 0.1 N per 0.5 s: 1.2 N at 6 s, 1.8 N at 9 s
+  for (std::size_t i = 0; i < p.trace.t.size(); ++i) {
+    if (p.trace.t[i] <= 6.0) x_at_1_2N = p.trace.x[i];
+    if (p.trace.t[i] <= 9.0) x_at_1_8N = p.trace.x[i];
+  }
+  EXPECT_LT(std::abs(x_at_1_2N - p.trace.x.front()), 0.003) << "moved before the 1.2 N breakaway force";
+  EXPECT_GT(x_at_1_8N - x_at_1_2N, 0.05) << "did not break away at 1.8 N";
 }
 
 TEST(Fit, RecoversHiddenParametersByResimulation) {
