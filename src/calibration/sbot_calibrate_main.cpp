@@ -17,6 +17,8 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
+#include <set>
 #include <sstream>
 
 #include "calibration/diagnose.h"
@@ -82,6 +84,33 @@ Args parse(int argc, char** argv) {
     }
   }
   return a;
+}
+
+/// The options each subcommand reads (besides --jobs, --quiet, --help). Anything else is refused:
+/// a misspelt option would otherwise be ignored, e.g. `compare --effect F` comparing the nominal model.
+const std::map<std::string, std::set<std::string>> kCommandOptions{
+    {"compare", {"effects", "level", "solver", "out", "no-plots", "no-align"}},
+    {"diagnose", {"effects", "level", "solver", "folds", "threshold", "seed", "candidates", "write-effects", "verbose"}},
+    {"fit", {"effect", "effects", "level", "solver", "out"}},
+    {"generate", {"out", "level", "solver", "seed", "duration", "tilt", "repeat", "max-runs", "name", "torque",
+                  "no-tilt", "no-speed", "families", "hidden", "hide"}},
+    {"sweep", {"cases", "set", "seeds", "first-seed", "level", "solver", "duration", "folds", "threshold", "torque",
+               "out"}},
+    {"effects", {}}};
+
+void checkOptions(const Args& a) {
+  auto it = kCommandOptions.find(a.cmd);
+  if (it == kCommandOptions.end()) return;  // unknown command: usage() says so
+  std::set<std::string> given;
+  for (const auto& [k, v] : a.opts) given.insert(k);
+  given.insert(a.flags.begin(), a.flags.end());
+  for (const auto& k : given) {
+    if (it->second.count(k) || k == "jobs" || k == "quiet" || k == "help") continue;
+    std::string accepted;
+    for (const auto& o : it->second) accepted += " --" + o;
+    throw std::invalid_argument("unknown option --" + k + " for '" + a.cmd + "' (it takes" +
+                                (accepted.empty() ? std::string(" none") : accepted) + ", and --jobs, --quiet)");
+  }
 }
 
 std::string pct(double v) {
@@ -297,6 +326,7 @@ int main(int argc, char** argv) {
       usage();
       return a.cmd.empty() ? 2 : 0;
     }
+    checkOptions(a);
     if (a.has("jobs")) WorkerPool::setGlobalSize(static_cast<int>(a.num("jobs", 0)));
     if (a.cmd == "effects") return cmdEffects();
     if (a.cmd == "compare") return cmdCompare(a);

@@ -1,0 +1,54 @@
+// The sbot_calibrate command line: options a subcommand does not take are refused with a message that
+// names them (a misspelt --effects used to be ignored, so `compare --effect F` compared the nominal
+// model), and so are bad values of the ones it does take.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <string>
+
+namespace {
+
+struct Outcome {
+  int status = -1;
+  std::string output;  ///< stdout and stderr
+};
+
+Outcome run(const std::string& args) {
+  const std::string cmd = std::string(SBOT_CALIBRATE_BIN) + " " + args + " 2>&1";
+  Outcome o;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return o;
+  std::array<char, 4096> buf{};
+  for (std::size_t n; (n = fread(buf.data(), 1, buf.size(), p)) > 0;) o.output.append(buf.data(), n);
+  const int st = pclose(p);
+  o.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return o;
+}
+
+const std::string kExample = std::string(SWARMBOT3D_SOURCE_DIR) + "/datasets/example";
+
+TEST(Cli, AnOptionTheSubcommandDoesNotTakeIsRefusedByName) {
+  const Outcome o = run("compare " + kExample + " --effect fitted.yaml --no-plots --out " + testing::TempDir() + "cli_typo");
+  EXPECT_EQ(o.status, 1) << o.output;
+  EXPECT_NE(o.output.find("unknown option --effect for 'compare'"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("--effects"), std::string::npos) << "lists what it takes: " << o.output;
+  const Outcome d = run("diagnose " + kExample + " --treshold 5");
+  EXPECT_EQ(d.status, 1) << d.output;
+  EXPECT_NE(d.output.find("unknown option --treshold for 'diagnose'"), std::string::npos) << d.output;
+}
+
+TEST(Cli, ABadSolverIsRefusedByName) {
+  const Outcome o = run("compare " + kExample + " --solver fast --no-plots --out " + testing::TempDir() + "cli_solver");
+  EXPECT_EQ(o.status, 1) << o.output;
+  EXPECT_NE(o.output.find("--solver expects quickstep or exact, got 'fast'"), std::string::npos) << o.output;
+}
+
+TEST(Cli, TheOptionsItTakesAreAccepted) {
+  const Outcome o = run("effects --jobs 1 --quiet");
+  EXPECT_EQ(o.status, 0) << o.output;
+  EXPECT_NE(o.output.find("speed_scale"), std::string::npos) << o.output;
+}
+
+}  // namespace
