@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "sbot_sim/core/effects/effect_registry.h"
 #include "sbot_sim/core/effects/effects_file.h"
@@ -32,6 +33,22 @@ struct Bench {
     return s.value;
   }
 };
+
+// The sensor-path counterpart of DriveEffects.NullValuesLeaveTheSimulationBitIdentical: every effect
+// of the library at its null value returns every kind of sample unchanged to the bit (an effect that
+// maps a distance to a reading and back would not).
+TEST(SensorEffects, NullValuesLeaveEveryReadingBitIdentical) {
+  Bench b;
+  const std::vector<SensorSample> samples{{"ir", 4, 0.03, "black_card", 0.5},
+                                          {"ir", 0, 0.12, "", 0.0},
+                                          {"ground", 1, 0.004, "white_paper", 0.1},
+                                          {"light", 2, 150.0, "", 0.7},
+                                          {kTrackSpeedChannel, 0, 0.11, "", 0.0}};
+  for (const auto& name : EffectRegistry::instance().names())
+    for (const SensorSample& s : samples)
+      EXPECT_EQ(b.apply({name, {}, {}, ""}, s), s.value) << name << " at its null value changed a " << s.channel
+                                                         << " sample";
+}
 
 TEST(SensorEffects, IrEffectsActOnTheReading) {
   Bench b;
