@@ -94,6 +94,18 @@ std::vector<Pattern> drivePatterns(const std::string& family, double dur, double
   return out;
 }
 
+// The IR calibration walls of the place and approach families: one per surface, 2 m long, far from
+// the drive runs (which start within 1 m of the origin). Their face is at x = kWallX.
+constexpr double kWallX = 30.0;
+struct CalibrationWall {
+  std::string surface;
+  double y;  ///< [m] centre of the wall along it
+};
+const std::vector<CalibrationWall>& calibrationWalls() {
+  static const std::vector<CalibrationWall> w{{"white_paper", -4.0}, {"grey_paper", 0.0}, {"black_card", 4.0}};
+  return w;
+}
+
 std::vector<double> stamps(double t_end, double hz, double phase) {
   std::vector<double> t;
   for (double s = phase; s <= t_end + 1e-9; s += 1.0 / hz) t.push_back(s);
@@ -103,7 +115,7 @@ std::vector<double> stamps(double t_end, double hz, double phase) {
 }  // namespace
 
 const std::vector<std::string>& generatorFamilies() {
-  static const std::vector<std::string> f{"straight", "spin", "arc", "square", "steps", "place"};
+  static const std::vector<std::string> f{"straight", "spin", "arc", "square", "steps", "place", "approach"};
   return f;
 }
 
@@ -136,7 +148,7 @@ Dataset generateDataset(const GeneratorOptions& opt, WorkerPool& pool, Generated
   std::vector<Pattern> patterns;
   for (int rep = 0; rep < std::max(1, opt.repeat); ++rep)
     for (const auto& f : generatorFamilies()) {
-      if (!families.count(f) || f == "place") continue;
+      if (!families.count(f) || f == "place" || f == "approach") continue;
       for (auto p : drivePatterns(f, opt.duration, width)) {
         if (opt.repeat > 1) p.name += "_r" + std::to_string(rep + 1);
         patterns.push_back(p);
@@ -200,25 +212,28 @@ Dataset generateDataset(const GeneratorOptions& opt, WorkerPool& pool, Generated
     ds.runs.push_back(run);
   }
 
-  // Static IR calibration ("place"): the robot placed in front of three walls of different surfaces
-  // (far from the drive runs), sensors 2, 7 and 12 facing the wall at 0-60 deg incidence and 1-16 cm.
+  if (families.count("place") || families.count("approach")) {
+    for (const auto& w : calibrationWalls())
+      ds.world.terrain.boxes.push_back({"wall_" + w.surface, Vec3(kWallX + 0.01, w.y, 0.05), Vec3(0.02, 2.0, 0.1), 0, 0,
+                                        w.surface});
+    real.terrain.boxes = ds.world.terrain.boxes;
+    if (truth) truth->world = real;
+  }
+
+  // Static IR calibration ("place"): the robot placed in front of the three walls, sensors 2, 7 and
+  // 12 facing the wall at 0-60 deg incidence and 1-16 cm.
   if (families.count("place")) {
     const auto ir = levelIrSensors(opt.level);
-    const std::vector<std::string> surfaces{"white_paper", "grey_paper", "black_card"};
-    const double wall_x = 30.0;
-    for (std::size_t si = 0; si < surfaces.size(); ++si) {
-      const double wall_y = -4.0 + 4.0 * si;
-      ds.world.terrain.boxes.push_back({"wall_" + surfaces[si], Vec3(wall_x + 0.01, wall_y, 0.05), Vec3(0.02, 2.0, 0.1),
-                                        0, 0, surfaces[si]});
+    for (const auto& w : calibrationWalls()) {
       // One run per (surface, sensor), grouped by surface so that every fold sees every surface.
       constexpr double kClearance = 0.065;  // [m] robot outline around base_link (turret, treels corners)
       for (int k : {2, 7, 12}) {
         if (k >= static_cast<int>(ir.size())) continue;
         Run run;
-        run.name = "place_" + surfaces[si] + "_ir" + std::to_string(k);
+        run.name = "place_" + w.surface + "_ir" + std::to_string(k);
         run.file = run.name + ".csv";
         run.kind = RunKind::Place;
-        run.group = surfaces[si];
+        run.group = w.surface;
         const Vec3 pk = ir[k].first;
         for (double deg : {0.0, 20.0, 40.0, 60.0}) {
           const double th = deg * M_PI / 180;
@@ -227,9 +242,9 @@ Dataset generateDataset(const GeneratorOptions& opt, WorkerPool& pool, Generated
             const double yaw = th - ir[k].second;  // sensor axis at angle th to the wall normal (+x)
             const double c = std::cos(yaw), sn = std::sin(yaw);
             const double sx = c * pk.x() - sn * pk.y(), sy = sn * pk.x() + c * pk.y();
-            const double bx = wall_x - d * std::cos(th) - sx;
-            const double by = wall_y - d * std::sin(th) - sy;
-            if (wall_x - bx < kClearance) continue;  // the robot would be inside the wall
+            const double bx = kWallX - d * std::cos(th) - sx;
+            const double by = w.y - d * std::sin(th) - sy;
+            if (kWallX - bx < kClearance) continue;  // the robot would be inside the wall
             run.placements.push_back({{bx, by, yaw}, kNaN});
           }
         }
@@ -246,8 +261,54 @@ Dataset generateDataset(const GeneratorOptions& opt, WorkerPool& pool, Generated
         ds.runs.push_back(run);
       }
     }
-    real.terrain.boxes = ds.world.terrain.boxes;
-    if (truth) truth->world = real;
+  }
+
+  // IR wall approaches ("approach", drive runs): the robot reverses toward each wall at 2.8 cm/s with
+  // its rear at 0, 20, 40 and 60 deg to the wall normal, from out of IR range until its centre is
+  // 8 cm from the wall (the rear sensors then read from ~3 cm), the IR ring logged all the way.
+  if (families.count("approach")) {
+    const std::size_t n_ir = levelIrSensors(opt.level).size();
+    constexpr double kCommand = -10;   // [units] 2.8 cm/s backwards
+    constexpr double kEndDistance = 0.08;  // [m] base_link to the wall face at the end
+    const double run_t = std::max(1.0, opt.duration - 1.0);
+    const double travel = std::abs(kCommand) * loadLevel(opt.level).treels.speed_unit * run_t;
+    for (const auto& w : calibrationWalls()) {
+      int j = 0;
+      for (double deg : {0.0, 20.0, 40.0, 60.0}) {
+        const double th = deg * M_PI / 180;  // direction of the rear, from the wall normal
+        Run run;
+        run.name = "approach_" + w.surface + "_" + std::to_string(static_cast<int>(deg));
+        run.file = run.name + ".csv";
+        run.kind = RunKind::Drive;
+        run.group = "approach_" + w.surface;  // every fold sees every surface
+        for (const auto& [t, c] : ramped({{0.0, {kCommand, kCommand}}, {run_t, {0, 0}}})) {
+          run.cmd_t.push_back(t);
+          run.cmd_left.push_back(c.first);
+          run.cmd_right.push_back(c.second);
+        }
+        run.t_end = opt.duration;
+        run.start_time = session;
+        session += opt.duration + 20.0;
+        const double lane = -0.45 + 0.3 * j++;  // one lane of the wall per incidence
+        run.initial_pose = {kWallX - kEndDistance - travel * std::cos(th),
+                            w.y + lane - 0.5 * travel * std::sin(th), wrapAngle(th + M_PI)};
+        std::mt19937_64 rng(stableHash(opt.seed, "run/" + run.name));
+        std::uniform_real_distribution<double> u01(0, 1);
+        auto add = [&](const std::string& c, double hz) {
+          Series sr;
+          sr.t = stamps(run.t_end, hz, u01(rng) / hz);
+          sr.v.assign(sr.t.size(), 0);
+          sr.line.assign(sr.t.size(), 0);
+          run.channels[c] = sr;
+        };
+        add("x", opt.tracker_hz);
+        run.channels["y"] = run.channels["x"];
+        run.channels["yaw"] = run.channels["x"];
+        add("ir0", opt.sensor_hz);  // the whole ring in one message: same stamps
+        for (std::size_t q = 1; q < n_ir; ++q) run.channels["ir" + std::to_string(q)] = run.channels["ir0"];
+        ds.runs.push_back(run);
+      }
+    }
   }
 
   // Simulate the "real" robot and measure it.

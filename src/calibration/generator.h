@@ -22,9 +22,10 @@ struct GeneratorOptions {
   std::vector<EffectConfig> hidden;        ///< effects switched on in the "real" robot
   double tilt_deg = 0;                     ///< hidden floor tilt [deg] (not in the library)
   double duration = 8;                     ///< [s] length of each drive pattern
-  /// Experiment families: straight, spin, arc, square, steps (drive runs); place (the IR wall
-  /// approaches as static placements: three surfaces, incidence 0-60 deg, 1-16 cm). Empty = the
-  /// drive families.
+  /// Experiment families: straight, spin, arc, square, steps (drive runs); place (static IR
+  /// placements before three surfaces, incidence 0-60 deg, 1-16 cm); approach (drive runs reversing
+  /// toward the three walls at 0-60 deg, the IR ring logged at sensor_hz). Empty = the five drive
+  /// families.
   std::set<std::string> experiments;
   int repeat = 1;                          ///< repeat the drive set (more runs)
   std::size_t max_runs = 0;                ///< 0 = all

@@ -126,7 +126,7 @@ void usage() {
                "  diagnose DATASET [--effects BASE] [--folds K] [--threshold DBIC] [--candidates a,b] [--write-effects FILE]\n"
                "  fit      DATASET --effect NAME [--effect NAME2] [--effects BASE] --out FILE\n"
                "  generate --out DIR [--level simple] [--solver quickstep|exact] [--seed N] [--hidden FILE] [--hide name:p=v+name2:p=v]\n"
-               "           [--tilt DEG] [--duration S] [--families straight,spin,arc,square,steps] [--repeat N]\n"
+               "           [--tilt DEG] [--duration S] [--families straight,spin,arc,square,steps,place,approach] [--repeat N]\n"
                "           [--max-runs N] [--name NAME] [--torque] [--no-tilt] [--no-speed]\n"
                "  sweep    [--out FILE.md] [--seeds N] [--cases a,b] [--level L] [--solver S] [--duration S]\n"
                "           [--set name:p=v+name2:p=v]  (another magnitude for the cases that hide those effects)\n"

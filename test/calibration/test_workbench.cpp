@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "calibration/diagnose.h"
 #include "calibration/evaluation.h"
 #include "calibration/fit.h"
 #include "calibration/generator.h"
@@ -120,6 +121,44 @@ TEST(SeedDatasets, TractionIsReproducedWithTheExactSolver) {
   }
   EXPECT_LT(std::abs(x_at_1_2N - p.trace.x.front()), 0.003) << "moved before the 1.2 N breakaway force";
   EXPECT_GT(x_at_1_8N - x_at_1_2N, 0.05) << "did not break away at 1.8 N";
+}
+
+// The approach family: drive runs reversing toward the three calibration walls with the IR ring
+// logged. The rear sensor reads the wall more and more strongly; a hidden black-card reflectance is
+// found from these runs alone (the IR channels of drive runs are replayed like the pose).
+TEST(Generator, WallApproachesRevealTheSurfaceReflectance) {
+  GeneratorOptions g;
+  g.seed = 5;
+  g.level = "medium";  // ray-traced IR
+  g.experiments = {"approach"};
+  g.hidden = {{"ir_reflectance", {{"black_card", 0.3}}, {}, ""}};
+  const Dataset ds = generateDataset(g, WorkerPool::global());
+  ASSERT_EQ(ds.runs.size(), 12u) << "3 surfaces x 4 incidences";
+  for (const auto& r : ds.runs) {
+    EXPECT_EQ(r.kind, RunKind::Drive) << r.name;
+    ASSERT_TRUE(r.channels.count("ir7") && r.channels.count("x")) << r.name;
+  }
+  ASSERT_EQ(ds.runs.at(0).name, "approach_white_paper_0");  // white paper, head-on
+  const Series& rear = ds.runs.at(0).channels.at("ir7");    // the rear sensor faces the wall
+  double early = 0, late = 0;  // strongest reading in the first 2 s, and after
+  for (std::size_t i = 0; i < rear.t.size(); ++i) {
+    double& m = rear.t[i] < 2.0 ? early : late;
+    m = std::max(m, rear.v[i]);
+  }
+  EXPECT_LT(early, 30) << "out of range at the start";
+  EXPECT_GT(late, 60) << "the wall seen at the end";
+  DiagnoseOptions d;
+  d.candidates = {"ir_reflectance", "ir_ambient"};
+  const DiagnoseResult r = diagnose(ds, d, WorkerPool::global());
+  ASSERT_FALSE(r.accepted.empty()) << r.verdict;
+  EXPECT_EQ(r.accepted.front(), "ir_reflectance") << r.verdict;
+  bool found = false;
+  for (std::size_t k = 0; k < r.final_fit.free.size(); ++k)
+    if (r.final_fit.free[k].name == "black_card") {
+      found = true;
+      EXPECT_NEAR(r.final_fit.value[k], 0.3, 0.03) << r.verdict;
+    }
+  EXPECT_TRUE(found) << "black_card fitted: " << r.verdict;
 }
 
 TEST(Fit, RecoversHiddenParametersByResimulation) {
