@@ -112,6 +112,40 @@ std::vector<double> stamps(double t_end, double hz, double phase) {
   return t;
 }
 
+// A drive run recorded `start_time` into the session: its commands, no channels yet.
+Run driveRun(const std::string& name, const std::string& group,
+             const std::vector<std::pair<double, std::pair<double, double>>>& cmds, double t_end, double start_time) {
+  Run run;
+  run.name = name;
+  run.file = name + ".csv";
+  run.kind = RunKind::Drive;
+  run.group = group;
+  for (const auto& [t, c] : cmds) {
+    run.cmd_t.push_back(t);
+    run.cmd_left.push_back(c.first);
+    run.cmd_right.push_back(c.second);
+  }
+  run.t_end = t_end;
+  run.start_time = start_time;
+  return run;
+}
+
+// The time stamps of a measured channel at `hz`, with a random phase; values to be simulated.
+void addChannel(Run& run, const std::string& channel, double hz, std::mt19937_64& rng) {
+  Series s;
+  s.t = stamps(run.t_end, hz, std::uniform_real_distribution<double>(0, 1)(rng) / hz);
+  s.v.assign(s.t.size(), 0);
+  s.line.assign(s.t.size(), 0);
+  run.channels[channel] = s;
+}
+
+// The overhead tracker: x, y, yaw from one message.
+void addTracker(Run& run, double hz, std::mt19937_64& rng) {
+  addChannel(run, "x", hz, rng);
+  run.channels["y"] = run.channels["x"];
+  run.channels["yaw"] = run.channels["x"];
+}
+
 }  // namespace
 
 const std::vector<std::string>& generatorFamilies() {
@@ -170,42 +204,22 @@ Dataset generateDataset(const GeneratorOptions& opt, WorkerPool& pool, Generated
     const Pattern& p = patterns[i];
     std::mt19937_64 rng(stableHash(opt.seed, "run/" + p.name));
     std::uniform_real_distribution<double> u01(0, 1);
-    Run run;
-    run.name = p.name;
-    run.file = p.name + ".csv";
-    run.kind = RunKind::Drive;
-    run.group = p.name.substr(0, p.name.find('_'));
-    for (const auto& [t, c] : p.cmds) {
-      run.cmd_t.push_back(t);
-      run.cmd_left.push_back(c.first);
-      run.cmd_right.push_back(c.second);
-    }
-    run.t_end = opt.duration;
-    run.start_time = session;
+    Run run = driveRun(p.name, p.name.substr(0, p.name.find('_')), p.cmds, opt.duration, session);
     session += opt.duration + 20.0;
     true_start[i] = {-1 + 2 * u01(rng), -1 + 2 * u01(rng), -M_PI + 2 * M_PI * u01(rng)};
-    auto add = [&](const std::string& c, double hz) {
-      Series s;
-      s.t = stamps(run.t_end, hz, u01(rng) / hz);
-      s.v.assign(s.t.size(), 0);
-      s.line.assign(s.t.size(), 0);
-      run.channels[c] = s;
-    };
-    add("x", opt.tracker_hz);
-    run.channels["y"] = run.channels["x"];
-    run.channels["yaw"] = run.channels["x"];
+    addTracker(run, opt.tracker_hz, rng);
     if (opt.measure_speed) {
-      add("speed_left", opt.encoder_hz);
+      addChannel(run, "speed_left", opt.encoder_hz, rng);
       run.channels["speed_right"] = run.channels["speed_left"];
     }
     if (opt.measure_torque) {
       // Encoders and torques come in one message (sbot_msgs/TrackState): same time stamps.
       if (opt.measure_speed && opt.torque_hz == opt.encoder_hz) run.channels["torque_left"] = run.channels["speed_left"];
-      else add("torque_left", opt.torque_hz);
+      else addChannel(run, "torque_left", opt.torque_hz, rng);
       run.channels["torque_right"] = run.channels["torque_left"];
     }
     if (opt.measure_tilt) {
-      add("pitch", opt.tilt_hz);
+      addChannel(run, "pitch", opt.tilt_hz, rng);
       run.channels["roll"] = run.channels["pitch"];
     }
     run.initial_pose = true_start[i];
@@ -276,35 +290,17 @@ Dataset generateDataset(const GeneratorOptions& opt, WorkerPool& pool, Generated
       int j = 0;
       for (double deg : {0.0, 20.0, 40.0, 60.0}) {
         const double th = deg * M_PI / 180;  // direction of the rear, from the wall normal
-        Run run;
-        run.name = "approach_" + w.surface + "_" + std::to_string(static_cast<int>(deg));
-        run.file = run.name + ".csv";
-        run.kind = RunKind::Drive;
-        run.group = "approach_" + w.surface;  // every fold sees every surface
-        for (const auto& [t, c] : ramped({{0.0, {kCommand, kCommand}}, {run_t, {0, 0}}})) {
-          run.cmd_t.push_back(t);
-          run.cmd_left.push_back(c.first);
-          run.cmd_right.push_back(c.second);
-        }
-        run.t_end = opt.duration;
-        run.start_time = session;
+        const std::string name = "approach_" + w.surface + "_" + std::to_string(static_cast<int>(deg));
+        // Grouped by surface: every fold sees every surface.
+        Run run = driveRun(name, "approach_" + w.surface, ramped({{0.0, {kCommand, kCommand}}, {run_t, {0, 0}}}),
+                           opt.duration, session);
         session += opt.duration + 20.0;
         const double lane = -0.45 + 0.3 * j++;  // one lane of the wall per incidence
         run.initial_pose = {kWallX - kEndDistance - travel * std::cos(th),
                             w.y + lane - 0.5 * travel * std::sin(th), wrapAngle(th + M_PI)};
         std::mt19937_64 rng(stableHash(opt.seed, "run/" + run.name));
-        std::uniform_real_distribution<double> u01(0, 1);
-        auto add = [&](const std::string& c, double hz) {
-          Series sr;
-          sr.t = stamps(run.t_end, hz, u01(rng) / hz);
-          sr.v.assign(sr.t.size(), 0);
-          sr.line.assign(sr.t.size(), 0);
-          run.channels[c] = sr;
-        };
-        add("x", opt.tracker_hz);
-        run.channels["y"] = run.channels["x"];
-        run.channels["yaw"] = run.channels["x"];
-        add("ir0", opt.sensor_hz);  // the whole ring in one message: same stamps
+        addTracker(run, opt.tracker_hz, rng);
+        addChannel(run, "ir0", opt.sensor_hz, rng);  // the whole ring in one message: same stamps
         for (std::size_t q = 1; q < n_ir; ++q) run.channels["ir" + std::to_string(q)] = run.channels["ir0"];
         ds.runs.push_back(run);
       }
