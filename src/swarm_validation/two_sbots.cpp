@@ -11,6 +11,8 @@
 //   two_sbots [--level detailed] [--trials 3] [--angles 10,20,...] [--steps 0.015,0.024,0.032]
 //             [--seed-friction]   (slope rows with the seed's force-limited 1.2 N friction, see
 //                                  two_sbots_trials.h; the step rows are unaffected)
+//             [--track-mu MU]     (slope rows with Coulomb treels of coefficient MU instead of 1.0)
+//             [--rear-uphill]     (slope rows facing downhill, climbing in reverse)
 //
 // The connection is the static front-gripper link (core/swarm/swarm_graph.h createStaticLink: fixed
 // joint, gripper_tip to the held robot's turret, 0.147 m apart); the holder's arm is driven by the
@@ -47,7 +49,8 @@ int main(int argc, char** argv) {
   int trials = 3;
   std::vector<double> angles{10, 20, 25, 29, 32, 35, 40, 45, 50, 55, 58, 65, 72};
   std::vector<double> steps{0.015, 0.024, 0.032};
-  bool verbose = false, seed_friction = false;
+  bool verbose = false;
+  SlopeSetup setup;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -56,14 +59,27 @@ int main(int argc, char** argv) {
     else if (a == "--angles") angles = parseList(next());
     else if (a == "--steps") steps = parseList(next());
     else if (a == "--verbose") verbose = true;
-    else if (a == "--seed-friction") seed_friction = true;
+    else if (a == "--seed-friction") setup.seed_friction = true;
+    else if (a == "--rear-uphill") setup.rear_uphill = true;
+    else if (a == "--track-mu") {
+      const std::string v = next();
+      char* end = nullptr;
+      setup.track_mu = std::strtod(v.c_str(), &end);
+      if (v.empty() || *end != '\0' || !std::isfinite(setup.track_mu) || setup.track_mu <= 0) {
+        std::fprintf(stderr, "two_sbots: --track-mu expects a positive number, found '%s'\n", v.c_str());
+        return 2;
+      }
+    }
     else {
-      std::fprintf(stderr, "usage: two_sbots [--level L] [--trials N] [--angles deg,...] [--steps m,...] [--verbose] [--seed-friction]\n");
+      std::fprintf(stderr, "usage: two_sbots [--level L] [--trials N] [--angles deg,...] [--steps m,...] [--verbose] "
+                           "[--seed-friction | --track-mu MU] [--rear-uphill]\n");
       return a == "--help" ? 0 : 2;
     }
   }
-  std::printf("two_sbots: level %s, %d trials per cell, friction %s\n\n", level.c_str(), trials,
-              seed_friction ? "seed (force limit 1.2 N per contact)" : "Coulomb (treels mu 1.0)");
+  const std::string friction = setup.seed_friction ? "seed (force limit 1.2 N per contact)"
+                               : "Coulomb (treels mu " + std::to_string(setup.track_mu > 0 ? setup.track_mu : 1.0).substr(0, 4) + ")";
+  std::printf("two_sbots: level %s, %d trials per cell, friction %s, %s\n\n", level.c_str(), trials, friction.c_str(),
+              setup.rear_uphill ? "rear uphill (climbing in reverse)" : "front uphill");
   std::printf("Table 4.1 slope (stand 3 s, climb 8 s at 2.8 cm/s); label per trial (slide [mm], climb efficiency)\n");
   std::printf("%6s  %-60s %-60s\n", "deg", "single s-bot", "two s-bots connected");
   std::vector<std::string> modal[2];  // per slope: single s-bot, pair
@@ -72,7 +88,9 @@ int main(int argc, char** argv) {
     for (int pair = 0; pair < 2; ++pair) {
       std::vector<sbot::validation::Outcome> trial_labels;
       for (int k = 0; k < trials; ++k) {
-        const SlopeResult r = pairSlope(level, deg * M_PI / 180, k, pair == 1, seed_friction);
+        SlopeSetup s = setup;
+        s.pair = pair == 1;
+        const SlopeResult r = pairSlope(level, deg * M_PI / 180, k, s);
         char buf[96];
         std::snprintf(buf, sizeof(buf), "%s(%.0f,%.2f) ", r.label.c_str(), r.slide * 1000, r.efficiency);
         cells[pair] += buf;

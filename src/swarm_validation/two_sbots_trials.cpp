@@ -25,14 +25,16 @@ double tiltOf(const Robot& r) {
 
 }  // namespace
 
-SlopeResult pairSlope(const std::string& level, double angle, int trial, bool pair, bool seed_friction) {
+SlopeResult pairSlope(const std::string& level, double angle, int trial, const SlopeSetup& setup) {
   WorldConfig c;
   c.seed = 7000 + trial;
-  if (seed_friction) {
+  if (setup.seed_friction) {
     constexpr double kSeedFrictionN = 1.2;  // 4.1.1 / Table 2.13: 12e4 dyne
     c.contact.coulomb = false;
     c.contact.mu = kSeedFrictionN;
     c.contact.material_mu["track"] = kSeedFrictionN;
+  } else if (setup.track_mu > 0) {
+    c.contact.material_mu["track"] = setup.track_mu;
   }
   World w(c);
   const double g = c.gravity;
@@ -40,11 +42,15 @@ SlopeResult pairSlope(const std::string& level, double angle, int trial, bool pa
   std::mt19937 rng(trial * 131 + static_cast<int>(angle * 1000));
   std::uniform_real_distribution<double> u(-0.02, 0.02);
   const RobotDescription& d = loadLevel(level);
-  // sbot_1 (holder) below, gripping sbot_0 above it (uphill = +x).
-  w.addRobot(d, {0, 0, u(rng)}, "sbot_1");
+  // Uphill = +x. sbot_1 (holder) grips sbot_0 in front of it: above it facing uphill, below it
+  // facing downhill (rear uphill; the pair then climbs in reverse).
+  const double facing = setup.rear_uphill ? -1.0 : 1.0;  // +1: fronts uphill
+  const double yaw = setup.rear_uphill ? M_PI : 0.0;
+  const bool pair = setup.pair;
+  w.addRobot(d, {0, 0, yaw + u(rng)}, "sbot_1");
   std::unique_ptr<actuators::FrontGripper> grip;
   if (pair) {
-    w.addRobot(d, {0.3, 0, u(rng)}, "sbot_0");
+    w.addRobot(d, {facing * 0.3, 0, yaw + u(rng)}, "sbot_0");
     swarm::createStaticLink(w, {"sbot_1", "sbot_0", swarm::kFrontGripper});
     grip = std::make_unique<actuators::FrontGripper>(w, w.robot("sbot_1"));
     grip->setElevation(0);
@@ -76,7 +82,7 @@ SlopeResult pairSlope(const std::string& level, double angle, int trial, bool pa
   res.slide = x0 - x1;
   const double hold_tilt = res.max_tilt;
   if (!toppled) {
-    for (Robot* r : rs) r->setSpeed(10, 10);
+    for (Robot* r : rs) r->setSpeed(facing * 10, facing * 10);
     run(8.0);
     res.efficiency = (meanX() - x1) / (10 * 0.0028 * 8.0);
   }

@@ -15,11 +15,22 @@ struct SlopeResult {
   double max_tilt = 0;     ///< [rad]
 };
 
-/// One s-bot (pair = false) or two connected by sbot_1's front gripper (sbot_0 uphill) on a slope of
-/// `angle` [rad] (tilted gravity): stand 3 s, climb 8 s. `seed_friction`: the seed's own set-up for
-/// this experiment (4.1.1: "ground friction ... set to ... 1.2 N"), i.e. ODE box friction with a
-/// force limit of 1.2 N per contact point, instead of our Coulomb treels (mu 1.0).
-SlopeResult pairSlope(const std::string& level, double angle, int trial, bool pair, bool seed_friction = false);
+/// How the slope trial is set up besides level, angle and trial. The defaults are the tallied rows.
+struct SlopeSetup {
+  bool pair = true;            ///< two s-bots connected by sbot_1's front gripper; false: sbot_1 alone
+  /// The seed's own set-up for this experiment (4.1.1: "ground friction ... set to ... 1.2 N"), i.e.
+  /// ODE box friction with a force limit of 1.2 N per contact point, instead of Coulomb treels.
+  bool seed_friction = false;
+  /// false: both robots face uphill (front first) and the holder below grips the robot above it.
+  /// true: both face downhill and climb in reverse (the single s-bot's matching orientation of
+  /// Table 4.1, rear uphill); the holder is then above, gripping the robot below it.
+  bool rear_uphill = false;
+  double track_mu = 0;         ///< > 0: Coulomb coefficient of the treels on the slope (default 1.0)
+};
+
+/// One s-bot or two connected s-bots on a slope of `angle` [rad] (tilted gravity): stand 3 s with
+/// the motors holding, then climb 8 s at 2.8 cm/s.
+SlopeResult pairSlope(const std::string& level, double angle, int trial, const SlopeSetup& setup = {});
 
 /// The Table 4.1 pair rows' limits [deg], from the modal label of the trials at each slope
 /// (`deg` ascending, `modal_labels` parallel to it). One rule for the two_sbots tool and sbot_validate.

@@ -40,6 +40,7 @@ WorldConfig configFor(const RobotDescription& d, std::uint64_t seed) {
     c.solver_iterations = std::atoi(e);
     c.level_iterations = false;
   }
+  if (const char* e = std::getenv("SBOT_VALIDATE_SOLVER")) c.solver = e;  // quickstep | exact (study)
   return c;
 }
 

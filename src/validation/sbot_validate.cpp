@@ -272,8 +272,9 @@ int main(int argc, char** argv) {
     };
     auto limitsFor = [&](bool seed_friction) {
       auto res = v::runParallel(static_cast<int>(deg.size()) * o.trials, o.jobs, [&](int i) {
-        const two_sbots::SlopeResult r =
-            two_sbots::pairSlope("detailed", deg[i / o.trials] * M_PI / 180, i % o.trials, true, seed_friction);
+        two_sbots::SlopeSetup setup;
+        setup.seed_friction = seed_friction;
+        const two_sbots::SlopeResult r = two_sbots::pairSlope("detailed", deg[i / o.trials] * M_PI / 180, i % o.trials, setup);
         Outcome out{r.label};
         out.value = r.slide;
         out.value2 = r.efficiency;

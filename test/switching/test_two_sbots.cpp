@@ -13,12 +13,17 @@ namespace {
 constexpr double kDeg = M_PI / 180;
 
 TEST(TwoSbots, SlopeRows) {
-  EXPECT_EQ(two_sbots::pairSlope("detailed", 29 * kDeg, 0, true).label, "full");
-  EXPECT_EQ(two_sbots::pairSlope("detailed", 58 * kDeg, 0, false).label, "topple");
+  two_sbots::SlopeSetup single;
+  single.pair = false;
+  EXPECT_EQ(two_sbots::pairSlope("detailed", 29 * kDeg, 0).label, "full");
+  EXPECT_EQ(two_sbots::pairSlope("detailed", 58 * kDeg, 0, single).label, "topple");
   // Stable at 58 deg: with the seed's friction set-up for this experiment (force limit 1.2 N per
   // contact); Coulomb treels (mu 1) slide from 45 deg (the report's mismatch).
-  EXPECT_NE(two_sbots::pairSlope("detailed", 58 * kDeg, 0, true, true).label, "topple");
-  EXPECT_EQ(two_sbots::pairSlope("detailed", 58 * kDeg, 0, false, true).label, "topple");
+  two_sbots::SlopeSetup seed_pair, seed_single;
+  seed_pair.seed_friction = seed_single.seed_friction = true;
+  seed_single.pair = false;
+  EXPECT_NE(two_sbots::pairSlope("detailed", 58 * kDeg, 0, seed_pair).label, "topple");
+  EXPECT_EQ(two_sbots::pairSlope("detailed", 58 * kDeg, 0, seed_single).label, "topple");
 }
 
 TEST(TwoSbots, StepPassing32mm) {
