@@ -487,7 +487,8 @@ std::string restFacts(const std::string& level) {
   const Vec3 com_b = base.inverse().transform(com);
   const Vec3 rpy = rpyFromQuat(base.orientation);
   std::ostringstream s;
-  s << level << ": mass " << m << " kg, bodies " << r.bodies().size() << ", COM in base frame (" << com_b.x() << ", "
+  s << level << ": mass " << m << " kg, bodies " << r.bodies().size()
+    << (r.turretLocked() ? " (turret welded to the treels while idle)" : "") << ", COM in base frame (" << com_b.x() << ", "
     << com_b.y() << ", " << com_b.z() << ") m, COM height above ground " << com.z() << " m, base height "
     << base.position.z() << " m, rest roll " << rpy.x() * 180 / M_PI << " deg pitch " << rpy.y() * 180 / M_PI
     << " deg";

@@ -35,12 +35,21 @@ void setBodyPose(dBodyID b, const Pose& pose) {
 }
 Vec3 vec(const dReal* v) { return Vec3(v[0], v[1], v[2]); }
 
+constexpr double kTurretLockTolerance = 0.5 * 0.034906585;  // [rad] half an API unit (1 deg)
+// The hinge rate is no test of rest: quickstep leaves it jittering by +-0.07 rad/s at the target.
+constexpr double kTurretSettleTime = 0.2;                   // [s] within tolerance before welding
 }  // namespace
 
 Robot::Robot(World& world, const RobotDescription& description, const std::string& name, int index,
              const Pose& base_pose)
-    : world_(world), description_(&description), name_(name), index_(index),
+    : world_(world), description_(&description), model_(&description), name_(name), index_(index),
       random_(world.config().seed, name) {
+  turret_joint_ = description.turret.joint;
+  if (weldsIdleTurret(world.config(), description)) {  // at rest on its zero at the start
+    welded_model_ = withTurretWelded(description, 0.0);
+    model_ = welded_model_.get();
+    turret_locked_ = true;
+  }
   build(base_pose);
 }
 
@@ -71,7 +80,7 @@ void Robot::destroyModel() {
 }
 
 void Robot::build(const Pose& base_pose) {
-  const RobotDescription& d = *description_;
+  const RobotDescription& d = *model_;
   // 1. Group links into rigid bodies: a fixed joint merges the child into its parent's body.
   //    group_T_link is each link's frame in its group's frame (the group's first link).
   struct Group {
@@ -359,6 +368,7 @@ dJointID Robot::hingeJoint(const std::string& joint) const {
 }
 
 double Robot::jointAngle(const std::string& joint) const {
+  if (turret_locked_ && joint == turret_joint_) return locked_angle_;
   const Hinge* h = hinge(joint);
   return h ? hingeAngle(*h) : 0.0;
 }
@@ -446,7 +456,10 @@ bool Robot::setTurretRotation(int pos) {
   return p != pos;
 }
 
-double Robot::turretAngle() const { return turret_hinge_ < 0 ? 0 : hingeAngle(hinges_[turret_hinge_]); }
+double Robot::turretAngle() const {
+  if (turret_locked_) return locked_angle_;
+  return turret_hinge_ < 0 ? 0 : hingeAngle(hinges_[turret_hinge_]);
+}
 
 int Robot::getTurretRotation() const {
   return roundToUnits(turretAngle() / description_->turret.unit, description_->turret.range_units);
@@ -455,6 +468,70 @@ int Robot::getTurretRotation() const {
 int Robot::getTurretRotationTorque() const {
   if (turret_hinge_ < 0) return 0;
   return roundToUnits(hinges_[turret_hinge_].effort / description_->turret.torque_unit, kApiLimit);
+}
+
+// ---- turret weld ---------------------------------------------------------------------------------
+
+
+/// Whether a level's idle turret is welded in this world. Only quickstep needs it, and only for a
+/// turret whose centre of mass is off its hinge axis (Basic, Medium, Detailed: 4 cm). dWorldStep
+/// resolves the hinge (and its Dantzig LCP fails on the welded Medium/Detailed treels: "LCP internal
+/// error", the robot veers 3-10 deg in 10 s). Simple's and Fast's turrets are balanced on the axis
+/// and converge on their hinge (+-1 deg in 10 s); welded, the symmetric Simple robot rocks between
+/// its casters (+-1.3 deg pitch) instead of resting on one, as it does on the hinge.
+bool Robot::weldsIdleTurret(const WorldConfig& c, const RobotDescription& d) {
+  if (!c.lock_idle_turret || c.solver != "quickstep" || d.turret.joint.empty()) return false;
+  const JointDescription* j = d.findJoint(d.turret.joint);
+  const LinkDescription* turret = j ? d.findLink(j->child) : nullptr;
+  if (!turret) return false;
+  constexpr double kOffAxis = 0.005;  // [m]
+  const Vec3 com = turret->inertial_origin.position, axis = j->axis.normalized();
+  return (com - axis * axis.dot(com)).norm() > kOffAxis;
+}
+
+std::unique_ptr<RobotDescription> Robot::withTurretWelded(const RobotDescription& d, double angle) {
+  auto welded = std::make_unique<RobotDescription>(d);
+  for (auto& j : welded->joints) {
+    if (j.name != d.turret.joint) continue;
+    j.type = JointDescription::Type::Fixed;
+    j.origin = j.origin * Pose(Vec3::Zero(), Quat(Eigen::AngleAxisd(angle, j.axis.normalized())));
+  }
+  welded->turret.joint.clear();  // no turret hinge to look for
+  return welded;
+}
+
+void Robot::updateTurretLock(double dt) {
+  if (turret_joint_.empty()) return;
+  if (!weldsIdleTurret(world_.config(), *description_)) {
+    if (turret_locked_) setTurretLocked(false);
+    return;
+  }
+  if (turret_locked_) {
+    if (std::abs(turret_target_ - locked_angle_) > kTurretLockTolerance) setTurretLocked(false);
+    return;
+  }
+  if (turret_hinge_ < 0) return;
+  const Hinge& h = hinges_[turret_hinge_];
+  const bool at_target = std::abs(turret_target_ - hingeAngle(h)) < kTurretLockTolerance;
+  turret_settled_for_ = at_target ? turret_settled_for_ + dt : 0.0;
+  if (turret_settled_for_ >= kTurretSettleTime) setTurretLocked(true);
+}
+
+void Robot::setTurretLocked(bool locked) {
+  if (locked == turret_locked_ || turret_joint_.empty()) return;
+  turret_settled_for_ = 0;
+  if (locked) {
+    const double angle = turretAngle();
+    std::unique_ptr<RobotDescription> welded = withTurretWelded(*description_, angle);
+    rebuild(*welded);  // captures the free turret's angle from its hinge
+    welded_model_ = std::move(welded);
+    turret_locked_ = true;
+    locked_angle_ = angle;
+  } else {
+    rebuild(*description_);  // captures the welded angle (turret_locked_ still true)
+    turret_locked_ = false;
+    welded_model_.reset();
+  }
 }
 
 // ---- state ---------------------------------------------------------------------------------------
@@ -483,6 +560,7 @@ std::vector<JointState> Robot::jointStates() const {
   std::vector<JointState> out;
   out.reserve(hinges_.size());
   for (const auto& h : hinges_) out.push_back({h.name, hingeAngle(h), hingeRate(h), h.effort});
+  if (turret_locked_) out.push_back({turret_joint_, locked_angle_, 0.0, 0.0});
   return out;
 }
 
@@ -501,6 +579,7 @@ void Robot::setBasePose(const Pose& pose) {
 // ---- stepping ------------------------------------------------------------------------------------
 
 void Robot::applyCommands(double dt, const std::vector<EffectPtr>& effects) {
+  updateTurretLock(dt);
   const TreelsSemantics& tr = description_->treels;
   TrackCommand cmd{req_left_, req_right_, tr.max_torque, tr.max_torque};
   for (const auto& e : effects) e->onCommand(*this, cmd, dt);

@@ -163,8 +163,8 @@ void parseTerrain(const YAML::Node& n, TerrainConfig& t, const std::string& file
 void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
   Fields f(n, "world", file);
   // lamps / ambient_light are read by the simulator node (sensed environment, not physics).
-  f.allowOnly({"step", "gravity", "solver", "solver_iterations", "solver_sor", "contact", "terrain", "lamps",
-               "ambient_light"});
+  f.allowOnly({"step", "gravity", "solver", "solver_iterations", "solver_sor", "lock_idle_turret", "contact", "terrain",
+               "lamps", "ambient_light"});
   w.solver = f.text("solver", w.solver);
   if (w.solver != "quickstep" && w.solver != "exact")
     throw ConfigError(file, f.path("solver"), "expected 'quickstep' or 'exact', found '" + w.solver + "'");
@@ -172,6 +172,7 @@ void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
   w.gravity = f.number("gravity", w.gravity);
   w.solver_iterations = static_cast<int>(f.positive("solver_iterations", w.solver_iterations));
   w.solver_sor = f.positive("solver_sor", w.solver_sor);
+  w.lock_idle_turret = f.flag("lock_idle_turret", w.lock_idle_turret);
   if (const YAML::Node c = f.node("contact")) {
     Fields cf(c, "world.contact", file);
     cf.allowOnly({"mu", "erp", "cfm", "bounce", "max_contacts", "coulomb", "materials"});

@@ -92,13 +92,21 @@ TEST(ActuatorGripper, StickyConnectsOnlyWhenTouchingAndClosing) {
     run(w, {&ga, &gb, &gc}, 0.01);
     ASSERT_EQ(w.connections().of("sbot_1").size(), 1u);
   }
-  // The rigid link drags the held robot along.
+  // The rigid link drags the held robot along: the grip point stays where it bit the ring. (The
+  // bases' distance is no measure: dragging the passive robot pitches both by 3-13 deg and lifts
+  // the gripper arm against its 0.5 N m servo, which moves them 5-13 mm apart.) The fixed joint
+  // gives under quickstep: up to 5.7 mm here with the held robot's turret welded to its treels,
+  // 1.9 mm with the turret on its hinge (the 30 g gripper against 0.56 kg instead of 0.31 kg).
   b.setTracksPassive(true);
-  const double d0 = (b.basePose().position - a.basePose().position).norm();
+  const auto gripInRing = [&] { return b.linkPose("turret").inverse().transform(a.linkPose("gripper_tip").position); };
+  const Vec3 grip0 = gripInRing();
+  const double bx0 = b.basePose().position.x();
   a.setSpeed(-30, -30);
-  run(w, {&ga, &gb, &gc}, 1.0);
-  EXPECT_NEAR((b.basePose().position - a.basePose().position).norm(), d0, 0.005);
-  EXPECT_LT(b.basePose().position.x(), 0.146 - 0.03);
+  for (int i = 0; i < 10; ++i) {
+    run(w, {&ga, &gb, &gc}, 0.1);
+    ASSERT_LT((gripInRing() - grip0).norm(), 0.008) << "after " << (i + 1) * 0.1 << " s";
+  }
+  EXPECT_LT(b.basePose().position.x(), bx0 - 0.03) << "30 units for 1 s: 8.4 cm if nothing slipped";
   // Opening releases.
   ga.setAperture(10);
   EXPECT_TRUE(w.connections().list().empty());

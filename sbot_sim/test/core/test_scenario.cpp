@@ -32,6 +32,8 @@ swarm: {count: 4, level: simple, layout: grid, spacing: 0.4}
   EXPECT_DOUBLE_EQ(s.robots[0].pose.yaw, 0.5);
   EXPECT_EQ(s.robots[1].name, "sbot_1");
   EXPECT_EQ(s.world.terrain.boxes.size(), 4u);
+  EXPECT_TRUE(s.world.lock_idle_turret) << "welded idle turrets by default";
+  EXPECT_FALSE(parseScenario("world: {lock_idle_turret: false}", "ok.yaml").world.lock_idle_turret);
 }
 
 TEST(Scenario, RobotCountOverride) {
@@ -54,6 +56,7 @@ TEST(Scenario, ErrorsNameFileAndField) {
             std::string::npos);
   EXPECT_NE(errorOf("robots: [{pose: {x: 1, z: 2}}]").find("'robots[0].pose.z': unknown field"), std::string::npos);
   EXPECT_NE(errorOf("wrold: {}").find("'wrold': unknown field"), std::string::npos);
+  EXPECT_NE(errorOf("world: {lock_idle_turret: sometimes}").find("'world.lock_idle_turret'"), std::string::npos);
   EXPECT_NE(errorOf("world: {terrain: {type: lava}}").find("'world.terrain.type'"), std::string::npos);
   EXPECT_NE(errorOf("seed: [1").find("bad.yaml: not valid YAML"), std::string::npos);
   EXPECT_NE(errorOf("robots: [{name: a}, {name: a}]").find("duplicate robot name 'a'"), std::string::npos);

@@ -262,8 +262,17 @@ double headingChange(const std::string& level, const std::string& solver, int un
   return wrapAngle(r.basePose().yaw() - yaw0) * 180 / M_PI;
 }
 
+TEST(Treels, SymmetricCommandsKeepTheHeadingUnderQuickstep) {
+  // Quickstep did not converge on the turret hinged 4 cm off its centre of mass: standing or at 60
+  // units, Basic and Medium turned 5-11 deg in 10 s. Welded while idle (WorldConfig::
+  // lock_idle_turret) they turn 0.4-2.7 deg (README, "Known flaw: yaw drift").
+  for (const std::string level : {"simple", "basic", "medium", "detailed"}) {
+    EXPECT_LT(std::abs(headingChange(level, "quickstep", 0)), 2.0) << level << " standing";
+    EXPECT_LT(std::abs(headingChange(level, "quickstep", 60)), 4.0) << level << " driving";
+  }
+}
+
 TEST(TreelsExactSolver, SymmetricCommandsDriveStraight) {
-  // Quickstep at 20 iterations turns Basic/Medium ~1 deg/s (README, "Known flaw: yaw drift").
   for (const std::string level : {"simple", "basic", "medium"}) {
     EXPECT_LT(std::abs(headingChange(level, "exact", 60)), 0.5) << level << " driving";
     EXPECT_LT(std::abs(headingChange(level, "exact", 0)), 0.2) << level << " standing";

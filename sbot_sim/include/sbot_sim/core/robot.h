@@ -16,6 +16,7 @@
 #include "sbot_sim/core/random_streams.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/types.h"
+#include "sbot_sim/core/world_config.h"
 
 namespace sbot {
 
@@ -81,6 +82,15 @@ class Robot {
   double trackTorqueRight() const;
   /// Turret angle [rad] relative to the treels.
   double turretAngle() const;
+  /// The turret is welded to the treels (WorldConfig::lock_idle_turret: quickstep, turrets whose
+  /// centre of mass is off their axis, i.e. Basic, Medium, Detailed): it has
+  /// stayed within half an API unit (1 deg) of its target for 0.2 s. A target more than that away
+  /// frees it again at the next step (both are in-place rebuilds, see switchDescription). While welded,
+  /// bodies() has one body fewer and getTurretRotationTorque() reads 0: the servo's holding torque
+  /// is not measured (the weld holds any load; the real servo gives way above 1.49 N m).
+  bool turretLocked() const { return turret_locked_; }
+  /// Whether robots of level `d` weld their idle turret in a world configured as `c`.
+  static bool weldsIdleTurret(const WorldConfig& c, const RobotDescription& d);
 
   /// World pose of the base_link frame.
   Pose basePose() const;
@@ -145,7 +155,16 @@ class Robot {
     double raw_angle = 0;   ///< ODE's wrapped angle at the last update
   };
 
+  /// Builds from model_ (the level's description, or its copy with the turret welded).
   void build(const Pose& base_pose);
+  /// switchDescription's work: rebuild from `model` in place, carrying the state over
+  /// (core/swarm/model_switch.cpp). description_ is already the level to be.
+  void rebuild(const RobotDescription& model);
+  /// Weld a settled turret, free one that has a new target (start of applyCommands).
+  void updateTurretLock(double dt);
+  void setTurretLocked(bool locked);
+  /// `d` with its turret joint fixed at `angle` [rad] (the turret merged into the treels' body).
+  static std::unique_ptr<RobotDescription> withTurretWelded(const RobotDescription& d, double angle);
   /// Destroys every ODE object this robot owns (bodies, geoms, its space, hinges, loop joints, the
   /// body drive) and empties the bookkeeping: ~Robot and switchDescription.
   void destroyModel();
@@ -163,7 +182,13 @@ class Robot {
   double hingeAngle(const Hinge& h) const;
 
   World& world_;
-  const RobotDescription* description_;
+  const RobotDescription* description_;  ///< the level (what description() returns)
+  const RobotDescription* model_;        ///< what the bodies are built from: description_ or welded_model_
+  std::unique_ptr<RobotDescription> welded_model_;
+  std::string turret_joint_;             ///< the level's turret joint ("" if it has none)
+  bool turret_locked_ = false;
+  double locked_angle_ = 0;              ///< [rad] unwrapped turret angle while welded
+  double turret_settled_for_ = 0;        ///< [s] the free turret has been at its target
   std::string name_;
   int index_;
   RandomStreams random_;

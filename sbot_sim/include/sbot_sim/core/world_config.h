@@ -64,14 +64,20 @@ struct WorldConfig {
   double gravity = 9.81;       ///< [m/s^2], pointing -z
   /// ODE stepper. "quickstep" (default): iterative, the validated configuration. "exact":
   /// dWorldStep's direct LCP solve per island: no yaw drift for Simple/Basic/Medium and faster for
-  /// them, but ODE reports LCP failures on Detailed and the validation tables were not re-run with
-  /// it (README, "Known flaw: yaw drift").
+  /// them, but ODE reports LCP failures on Detailed and the validation tables fall apart with it
+  /// (README, "Yaw drift and the turret weld"; src/validation/README.md, "Solver").
   std::string solver = "quickstep";
   int solver_iterations = 20;  ///< ODE quickstep iterations (ODE default; see README benchmark)
   /// Raise the iterations to what the robots' levels need (RobotDescription::solver_iterations,
   /// Detailed: 40) while such a robot is in the world. Off only to study the solver itself.
   bool level_iterations = true;
   double solver_sor = 1.3;     ///< ODE quickstep over-relaxation
+  /// A turret that has reached its target is welded to the treels (one rigid body) until it is
+  /// commanded elsewhere (Robot::turretLocked; quickstep only, and only turrets whose centre of
+  /// mass is off their axis: Robot::weldsIdleTurret). Quickstep does not converge on the turret's
+  /// 4 cm off-axis centre of mass hinged to the treels: with the hinge a standing Medium turns
+  /// -11 deg in 10 s, welded +1.5 (README, "Yaw drift and the turret weld"). Off only to study that.
+  bool lock_idle_turret = true;
   std::uint64_t seed = 1;      ///< root of every random stream
   ContactConfig contact;
   TerrainConfig terrain;

@@ -19,6 +19,8 @@
 //    new level has no side arm) or the turret (held: the stickable ring). Fixed joints keep the
 //    current relative pose (which the switch does not change); ball/hinge anchors are re-set at the
 //    same world point.
+// The same rebuild welds a settled turret to the treels and frees it again (Robot::turretLocked):
+// the welded model is the level's description with the turret joint fixed at the turret's angle.
 // Not carried: joint motor states of modules (the gripper / side-arm modules re-apply their targets
 // every step) and anything a module cached from the old bodies.
 #include <cmath>
@@ -60,7 +62,18 @@ void Robot::switchDescription(const RobotDescription& d) {
                           " kg) to '" + d.level + "' (" + std::to_string(m_new) +
                           " kg): levels of different scale (Fast is half size in 1/50 gravity)");
   }
+  description_ = &d;
+  // A welded turret stays welded at the same angle if the new level welds idle turrets too.
+  std::unique_ptr<RobotDescription> welded;
+  if (turret_locked_ && weldsIdleTurret(world_.config(), d)) welded = withTurretWelded(d, locked_angle_);
+  rebuild(welded ? *welded : d);
+  turret_joint_ = d.turret.joint;
+  turret_locked_ = welded != nullptr;
+  welded_model_ = std::move(welded);
+}
 
+void Robot::rebuild(const RobotDescription& d) {
+  const RobotDescription& old = *model_;
   // ---- 1. capture the state -----------------------------------------------------------------------
   const Pose base = basePose();
   const Vec3 v_base = linearVelocity();
@@ -70,6 +83,7 @@ void Robot::switchDescription(const RobotDescription& d) {
     q[h.name] = hingeAngle(h);
     qd[h.name] = hingeRate(h);
   }
+  if (turret_locked_) q[turret_joint_] = locked_angle_, qd[turret_joint_] = 0;  // welded: no hinge
   const double track_left = trackSpeedLeft(), track_right = trackSpeedRight();
 
   // Link names per old body (to re-attach external joints to the same link).
@@ -137,7 +151,7 @@ void Robot::switchDescription(const RobotDescription& d) {
   destroyModel();
 
   // ---- 3. build the new one at the zero configuration -----------------------------------------------
-  description_ = &d;
+  model_ = &d;
   build(base);
 
   // ---- 4. forward kinematics to the carried joint angles and rates ---------------------------------
@@ -190,8 +204,8 @@ void Robot::switchDescription(const RobotDescription& d) {
     h.angle = it == q.end() ? h.raw_angle : it->second;
     h.effort = 0;
   }
-  if (turret_hinge_ >= 0) {
-    const double lim = d.turret.range_units * d.turret.unit;
+  if (!description_->turret.joint.empty()) {
+    const double lim = description_->turret.range_units * description_->turret.unit;
     turret_target_ = std::max(-lim, std::min(lim, turret_target_));
   }
 
