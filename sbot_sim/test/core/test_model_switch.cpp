@@ -122,7 +122,7 @@ TEST(ModelSwitch, LevelsRoundTrip) {
   for (const std::string l : {"basic", "medium", "detailed", "medium", "basic", "simple"}) {
     w.switchLevel("sbot_0", loadLevel(l));
     EXPECT_EQ(r.level(), l);
-    // A welded turret (Robot::turretLocked) is merged into the treels' body.
+    // A welded turret (Robot::turretLocked, opt-in) is merged into the treels' body.
     EXPECT_EQ(r.bodies().size() + (r.turretLocked() ? 1 : 0),
               static_cast<std::size_t>(std::stoi(r.description().extraOr("dynamical_bodies", "0"))));
     runFor(w, 0.3);

@@ -32,8 +32,8 @@ swarm: {count: 4, level: simple, layout: grid, spacing: 0.4}
   EXPECT_DOUBLE_EQ(s.robots[0].pose.yaw, 0.5);
   EXPECT_EQ(s.robots[1].name, "sbot_1");
   EXPECT_EQ(s.world.terrain.boxes.size(), 4u);
-  EXPECT_TRUE(s.world.lock_idle_turret) << "welded idle turrets by default";
-  EXPECT_FALSE(parseScenario("world: {lock_idle_turret: false}", "ok.yaml").world.lock_idle_turret);
+  EXPECT_FALSE(s.world.lock_idle_turret) << "idle turrets on their hinge by default";
+  EXPECT_TRUE(parseScenario("world: {lock_idle_turret: true}", "ok.yaml").world.lock_idle_turret);
 }
 
 TEST(Scenario, RobotCountOverride) {

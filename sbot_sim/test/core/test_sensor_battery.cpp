@@ -76,9 +76,9 @@ TEST(Battery, DrivingDrawsMotorPowerAndTheVoltageSags) {
   EXPECT_NEAR(b.power(), 2.5 + mech / 0.5, 1e-9);
   EXPECT_LT(b.voltage(), idle.voltage());
   // Turning on the spot for a minute uses clearly more than idling for a minute (150 J): the
-  // skidding treels work against friction. (Straight at a constant speed on flat ground the motors
-  // do almost no work: 159 J in a minute, as the converged solver says; the unconverged turret
-  // hinge used to add ~10 J of torque jitter.)
+  // skidding treels work against friction (216 J). Straight at a constant speed on flat ground the
+  // motors do almost no work: with the turret welded (opt-in) cruising takes 159 J, on its hinge
+  // quickstep's unconverged hinge adds ~10 J of torque jitter; neither measures the battery model.
   r.setSpeed(50, -50);
   Battery driving(r);
   for (int i = 0; i < 6000; ++i) {

@@ -38,6 +38,12 @@ std::size_t levelBodies(const Robot& r) {
   return static_cast<std::size_t>(std::stoi(r.description().extraOr("dynamical_bodies", "0")));
 }
 
+WorldConfig weldingWorld() {
+  WorldConfig c = flatWorld();
+  c.lock_idle_turret = true;
+  return c;
+}
+
 double jointPosition(const Robot& r, const std::string& joint) {
   for (const JointState& j : r.jointStates())
     if (j.name == joint) return j.position;
@@ -46,7 +52,7 @@ double jointPosition(const Robot& r, const std::string& joint) {
 }
 
 TEST(TurretWeld, ASettledTurretIsWeldedAndANewTargetFreesIt) {
-  World w(flatWorld());
+  World w(weldingWorld());
   Robot& r = w.addRobot(loadLevel("medium"), {0, 0, 0}, "sbot_0");
   const std::string joint = r.description().turret.joint;
   EXPECT_TRUE(r.turretLocked()) << "at rest on its zero from the start";
@@ -83,7 +89,7 @@ TEST(TurretWeld, ASettledTurretIsWeldedAndANewTargetFreesIt) {
 }
 
 TEST(TurretWeld, OnlyTurretsWithTheirMassOffTheAxis) {
-  World w(flatWorld());
+  World w(weldingWorld());
   for (const std::string level : {"fast", "simple", "basic", "medium", "detailed"}) {
     const bool off_axis = level != "fast" && level != "simple";  // the 4 cm COM offset (seed 2.2.2)
     EXPECT_EQ(Robot::weldsIdleTurret(w.config(), loadLevel(level)), off_axis) << level;
@@ -100,12 +106,10 @@ TEST(TurretWeld, OnlyTurretsWithTheirMassOffTheAxis) {
   EXPECT_EQ(r.bodies().size(), levelBodies(r));
 }
 
-TEST(TurretWeld, OffByConfigurationAndWithTheExactSolver) {
-  WorldConfig off = flatWorld();
-  off.lock_idle_turret = false;
-  WorldConfig exact = flatWorld();
+TEST(TurretWeld, OffByDefaultAndWithTheExactSolver) {
+  WorldConfig exact = weldingWorld();
   exact.solver = "exact";
-  for (const WorldConfig& c : {off, exact}) {
+  for (const WorldConfig& c : {flatWorld(), exact}) {
     World w(c);
     Robot& r = w.addRobot(loadLevel("medium"), {0, 0, 0}, "sbot_0");
     runFor(w, 0.5);
