@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <random>
 #include <vector>
@@ -23,6 +24,11 @@ double tiltOf(const Robot& r) {
   return std::acos(std::max(-1.0, std::min(1.0, up.z())));
 }
 
+/// $SBOT_VALIDATE_WELD: the opt-in turret weld, as sbot_validate reads it (src/validation/README.md).
+void studyKnobs(WorldConfig& c) {
+  if (std::getenv("SBOT_VALIDATE_WELD")) c.lock_idle_turret = true;
+}
+
 }  // namespace
 
 SlopeResult pairSlope(const std::string& level, double angle, int trial, const SlopeSetup& setup) {
@@ -36,6 +42,7 @@ SlopeResult pairSlope(const std::string& level, double angle, int trial, const S
   } else if (setup.track_mu > 0) {
     c.contact.material_mu["track"] = setup.track_mu;
   }
+  studyKnobs(c);
   World w(c);
   const double g = c.gravity;
   dWorldSetGravity(w.odeWorld(), -g * std::sin(angle), 0, -g * std::cos(angle));
@@ -100,6 +107,7 @@ StepResult stepBackward(const std::string& level, double h, int trial, bool pair
   c.seed = 8000 + trial;
   c.terrain.type = TerrainConfig::Type::Composite;
   c.terrain.boxes.push_back({"step", Vec3(-1.0, 0, h / 2), Vec3(2.0, 1.0, h), 0, 0, "ground"});
+  studyKnobs(c);
   World w(c);
   std::mt19937 rng(trial * 977 + static_cast<int>(h * 1e4));
   std::uniform_real_distribution<double> u(-1, 1);

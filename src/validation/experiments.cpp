@@ -41,6 +41,7 @@ WorldConfig configFor(const RobotDescription& d, std::uint64_t seed) {
     c.level_iterations = false;
   }
   if (const char* e = std::getenv("SBOT_VALIDATE_SOLVER")) c.solver = e;  // quickstep | exact (study)
+  if (std::getenv("SBOT_VALIDATE_WELD")) c.lock_idle_turret = true;       // opt-in turret weld (study)
   return c;
 }
 
