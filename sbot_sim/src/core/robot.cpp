@@ -35,7 +35,6 @@ void setBodyPose(dBodyID b, const Pose& pose) {
 }
 Vec3 vec(const dReal* v) { return Vec3(v[0], v[1], v[2]); }
 
-constexpr double kTurretLockTolerance = 0.5 * 0.034906585;  // [rad] half an API unit (1 deg)
 // The hinge rate is no test of rest: quickstep leaves it jittering by +-0.07 rad/s at the target.
 constexpr double kTurretSettleTime = 0.2;                   // [s] within tolerance before welding
 }  // namespace
@@ -45,7 +44,8 @@ Robot::Robot(World& world, const RobotDescription& description, const std::strin
     : world_(world), description_(&description), model_(&description), name_(name), index_(index),
       random_(world.config().seed, name) {
   turret_joint_ = description.turret.joint;
-  if (weldsIdleTurret(world.config(), description)) {  // at rest on its zero at the start
+  welds_turret_ = weldsIdleTurret(world.config(), description);
+  if (welds_turret_) {  // at rest on its zero at the start
     welded_model_ = withTurretWelded(description, 0.0);
     model_ = welded_model_.get();
     turret_locked_ = true;
@@ -501,18 +501,15 @@ std::unique_ptr<RobotDescription> Robot::withTurretWelded(const RobotDescription
 }
 
 void Robot::updateTurretLock(double dt) {
-  if (turret_joint_.empty()) return;
-  if (!weldsIdleTurret(world_.config(), *description_)) {
-    if (turret_locked_) setTurretLocked(false);
-    return;
-  }
+  if (!welds_turret_) return;  // (switchDescription frees a welded turret the new level does not weld)
+  const double tolerance = 0.5 * description_->turret.unit;  // half an API unit (1 deg)
   if (turret_locked_) {
-    if (std::abs(turret_target_ - locked_angle_) > kTurretLockTolerance) setTurretLocked(false);
+    if (std::abs(turret_target_ - locked_angle_) > tolerance) setTurretLocked(false);
     return;
   }
   if (turret_hinge_ < 0) return;
   const Hinge& h = hinges_[turret_hinge_];
-  const bool at_target = std::abs(turret_target_ - hingeAngle(h)) < kTurretLockTolerance;
+  const bool at_target = std::abs(turret_target_ - hingeAngle(h)) < tolerance;
   turret_settled_for_ = at_target ? turret_settled_for_ + dt : 0.0;
   if (turret_settled_for_ >= kTurretSettleTime) setTurretLocked(true);
 }

@@ -186,6 +186,7 @@ class Robot {
   const RobotDescription* model_;        ///< what the bodies are built from: description_ or welded_model_
   std::unique_ptr<RobotDescription> welded_model_;
   std::string turret_joint_;             ///< the level's turret joint ("" if it has none)
+  bool welds_turret_ = false;            ///< weldsIdleTurret(world config, level), per level
   bool turret_locked_ = false;
   double locked_angle_ = 0;              ///< [rad] unwrapped turret angle while welded
   double turret_settled_for_ = 0;        ///< [s] the free turret has been at its target

@@ -64,8 +64,9 @@ void Robot::switchDescription(const RobotDescription& d) {
   }
   description_ = &d;
   // A welded turret stays welded at the same angle if the new level welds idle turrets too.
+  welds_turret_ = weldsIdleTurret(world_.config(), d);
   std::unique_ptr<RobotDescription> welded;
-  if (turret_locked_ && weldsIdleTurret(world_.config(), d)) welded = withTurretWelded(d, locked_angle_);
+  if (turret_locked_ && welds_turret_) welded = withTurretWelded(d, locked_angle_);
   rebuild(welded ? *welded : d);
   turret_joint_ = d.turret.joint;
   turret_locked_ = welded != nullptr;
