@@ -63,10 +63,13 @@ double headingOf(const Robot& r) {
   return std::atan2(f.y(), f.x());
 }
 
-/// Run `seconds` of simulated time, calling `check` every 0.05 s; stops early when it returns true.
+/// Steps between two calls of runFor's check: ~0.05 s (every step for Fast's 0.1 s).
+int checkEvery(const World& w) { return std::max(1, static_cast<int>(std::lround(0.05 / w.config().step))); }
+
+/// Step `w` for `seconds`, calling `check` every checkEvery(w) steps (~0.05 s); stop when it returns true.
 template <typename F>
 void runFor(World& w, double seconds, F check) {
-  const int every = std::max(1, static_cast<int>(std::lround(0.05 / w.config().step)));
+  const int every = checkEvery(w);
   const int steps = static_cast<int>(std::ceil(seconds / w.config().step));
   for (int s = 0; s < steps; ++s) {
     w.step();
@@ -258,12 +261,17 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial) {
     const Vec3 p = r.basePose().position;
     return p.x() > 0 ? std::hypot(p.x(), std::max(0.0, p.z() - z0)) : 0.0;
   };
-  // Do the tracks still turn? Mean encoder speed over the last 2 s relative to the command:
-  // separates "slipping" (tracks turn, no progress) from "stuck" (tracks stalled).
-  std::deque<double> track_ratio;
+  // Over the last 2 s (for a robot short of the goal): do the tracks still turn (mean encoder
+  // speed relative to the command), do the driven wheels carry weight, has the robot moved?
+  std::deque<double> track_ratio, load_ratio;
+  std::deque<Vec3> positions;
+  const double weight = d.totalMass() * c.gravity;
+  const std::size_t window = static_cast<std::size_t>(std::lround(2.0 / (checkEvery(w) * c.step)));  // 2 s
   runFor(w, (0.12 * s + 0.30 * s) / kSlowSpeed * 1.3 + 4.0, [&] {
     track_ratio.push_back(0.5 * (std::fabs(r.trackSpeedLeft()) + std::fabs(r.trackSpeedRight())) / kSlowSpeed);
-    if (track_ratio.size() > 40) track_ratio.pop_front();
+    load_ratio.push_back(r.driveWheelLoad() / weight);
+    positions.push_back(r.basePose().position);
+    if (track_ratio.size() > window) { track_ratio.pop_front(); load_ratio.pop_front(); positions.pop_front(); }
     const Vec3 up = upOf(r);
     if (angleBetween(up, Vec3::UnitZ()) > 100 * M_PI / 180 ||
         (r.basePose().position.x() > 0 && angleBetween(up, normal) > 75 * M_PI / 180)) {
@@ -278,11 +286,18 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial) {
   o.value = best;
   o.value2 = dh;
   if (o.label == "stuck") {
-    double turning = 0;
+    double turning = 0, load = 0;
     for (double t : track_ratio) turning += t / track_ratio.size();
+    for (double t : load_ratio) load += t / load_ratio.size();
+    const double travel = (positions.back() - positions.front()).norm();
+    // Over the last 2 s: "travelling" = at least a quarter of the commanded distance; "slipping"
+    // needs tracks that turn (encoders >= 50 % of the command) while the driven wheels carry at
+    // least a quarter of the weight. Tracks spinning free (the robot hung up on its chassis or
+    // casters) do not slip: that robot is stuck.
+    const bool travelling = travel >= 0.25 * kSlowSpeed * 2.0;
     if (best > 0.03 * s && along() < best - 0.03 * s) o.label = "slide back";
-    else if (best <= 0.05 * s && dh > 0.35) o.label = "c/c";
-    else if (turning >= 0.5) o.label = "slipping";
+    else if (best <= 0.05 * s && dh > 0.35 && travelling) o.label = "c/c";
+    else if (turning >= 0.5 && load >= 0.25) o.label = "slipping";
   }
   return o;
 }

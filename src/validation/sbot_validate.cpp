@@ -29,6 +29,7 @@
 #include "experiments.h"
 #include "two_sbots_trials.h"
 #include "sbot_sim/core/robot_description.h"
+#include "sbot_sim/core/world_config.h"
 
 using sbot::validation::Outcome;
 namespace v = sbot::validation;
@@ -412,7 +413,8 @@ int main(int argc, char** argv) {
       auto r = v::runParallel(1, 1, [&](int) { return v::rtmTrial(level, o.quick ? secs / 3 : secs); });
       auto p = v::runParallel(1, 1, [&](int) { return v::rtmTrial(level, o.quick ? secs / 3 : secs, false); });
       const double target = 10 * seed.at(level);
-      const std::string it = sbot::loadLevel(level).extraOr("solver_iterations", "20 (default)");
+      const int needs = sbot::loadLevel(level).solver_iterations;  // 0: the world default
+      const std::string it = needs > 0 ? std::to_string(needs) : std::to_string(sbot::WorldConfig().solver_iterations) + " (default)";
       md << "| " << level << " | " << sbot::loadLevel(level).recommended_step * 1000 << " ms | " << it << " | " << seed.at(level)
          << " | " << target << " | " << fmt(r[0].value, 0) << " | " << fmt(r[0].value2, 4) << " | "
          << (r[0].value >= target ? "yes" : "**no**") << " | " << fmt(p[0].value, 0) << " |\n";
@@ -521,8 +523,10 @@ int main(int argc, char** argv) {
     md << "## Table 4.6 - uphill slope per level at 2.8 cm/s (modal of " << o.trials << ")\n\n"
        << "The robot starts 12 cm before the foot of a ramp. climb: 25 cm up the slope; topple: over "
           "backwards; slide back: got > 3 cm up and lost > 3 cm again; c/c: at the foot (< 5 cm up) with its "
-          "heading changed > 20 deg; slipping: short of 25 cm with its tracks still turning (encoders >= 50 % of the "
-          "command over the last 2 s); stuck: short of 25 cm with the tracks stalled.\n\n"
+          "heading changed > 20 deg, still travelling (>= 25 % of the commanded distance over the last 2 s); "
+          "slipping: short of 25 cm with its tracks turning (encoders >= 50 % of the command over the last 2 s) "
+          "while the driven wheels carry >= 25 % of the weight; stuck: short of 25 cm otherwise (tracks stalled, "
+          "or spinning free with the robot hung up on its chassis or casters).\n\n"
        << "| angle | level | seed | ours | match |\n|---|---|---|---|---|\n";
     for (std::size_t a = 0; a < ang.size(); ++a) {
       for (std::size_t l = 0; l < kLevels.size(); ++l) {

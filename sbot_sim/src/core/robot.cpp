@@ -208,6 +208,13 @@ void Robot::build(const Pose& base_pose) {
 
   for (const auto& jn : d.treels.left_joints) left_hinges_.push_back(hinge_index_.at(jn));
   for (const auto& jn : d.treels.right_joints) right_hinges_.push_back(hinge_index_.at(jn));
+  for (const auto* side : {&left_hinges_, &right_hinges_}) {
+    for (int i : *side) {
+      const dBodyID wheel = bodies_[hinges_[i].child_body];
+      for (dGeomID g : geoms_)
+        if (dGeomGetBody(g) == wheel) static_cast<GeomInfo*>(dGeomGetData(g))->drive_wheel = true;
+    }
+  }
   if (!d.turret.joint.empty()) turret_hinge_ = hinge_index_.at(d.turret.joint);
   measureTrackWidth();
   if (d.treels.drive == "body") {

@@ -210,6 +210,7 @@ void World::step() {
     dWorldStep(world_, dt);
   else
     dWorldQuickStep(world_, dt);
+  updateDriveWheelLoads();
   dJointGroupEmpty(contacts_);
   for (auto& r : robots_) r->readFeedback(dt);
   time_ += dt;
@@ -267,7 +268,28 @@ void World::handlePair(dGeomID a, dGeomID b) {
     }
     dJointID c = dJointCreateContact(world_, contacts_, &contacts[i]);
     dJointAttach(c, ba, bb);
+    const bool wheel_a = ia && ia->drive_wheel, wheel_b = ib && ib->drive_wheel;
+    if (wheel_a || wheel_b) {
+      wheel_contacts_.push_back({{}, ctx.normal, wheel_a ? ia->robot : nullptr, wheel_b ? ib->robot : nullptr, ba == nullptr});
+      dJointSetFeedback(c, &wheel_contacts_.back().feedback);
+    }
   }
+}
+
+void World::updateDriveWheelLoads() {
+  for (auto& r : robots_) r->setDriveWheelLoad(0);
+  auto add = [](Robot* r, const dVector3 force, double sign, const Vec3& normal) {
+    const double push = sign * Vec3(force[0], force[1], force[2]).dot(normal);
+    if (r && push > 0) r->setDriveWheelLoad(r->driveWheelLoad() + push);
+  };
+  for (const WheelContact& w : wheel_contacts_) {
+    // The contact normal points from geom 2 into geom 1: body 1 is pushed along it, body 2
+    // against it. A contact whose body 1 is static is stored reversed by ODE: its body 2's force
+    // is reported in f1.
+    add(w.wheel_of_body1, w.feedback.f1, 1.0, w.normal);
+    add(w.wheel_of_body2, w.body1_static ? w.feedback.f1 : w.feedback.f2, -1.0, w.normal);
+  }
+  wheel_contacts_.clear();
 }
 
 namespace {

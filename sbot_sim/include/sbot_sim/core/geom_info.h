@@ -12,6 +12,7 @@ struct GeomInfo {
   Robot* robot = nullptr;        ///< null for terrain and obstacles
   std::string material;          ///< contact material / optical surface label
   std::string link;              ///< URDF link (robots) or obstacle name (static geometry)
+  bool drive_wheel = false;      ///< on a driven treels wheel (Robot::driveWheelLoad measures its contacts)
 };
 
 }  // namespace sbot

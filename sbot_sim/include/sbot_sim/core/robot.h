@@ -80,6 +80,11 @@ class Robot {
   /// step-to-step jitter (Medium, quickstep, 40 units: sd 4.8 API units per step, 0.6 over 0.1 s).
   double trackTorqueLeft() const;
   double trackTorqueRight() const;
+  /// Normal force the surroundings (ground, obstacles, other robots) exerted on the driven
+  /// treels wheels in the last step [N]: the load the tracks can grip with. About the robot's
+  /// weight on flat ground; near 0 when it is airborne or hung up on its chassis or casters
+  /// (the body drive's traction and the validation's "stuck" versus "slipping" use it).
+  double driveWheelLoad() const { return drive_wheel_load_; }
   /// Turret angle [rad] relative to the treels.
   double turretAngle() const;
   /// The turret is welded to the treels (WorldConfig::lock_idle_turret: quickstep, turrets whose
@@ -134,6 +139,7 @@ class Robot {
   // ---- used by World -----------------------------------------------------------------------------
   void applyCommands(double dt, const std::vector<EffectPtr>& effects);
   void readFeedback(double dt);
+  void setDriveWheelLoad(double newtons) { drive_wheel_load_ = newtons; }
   dBodyID baseBody() const;
   dSpaceID space() const { return space_; }
   const std::vector<dBodyID>& bodies() const { return bodies_; }
@@ -209,6 +215,7 @@ class Robot {
   double track_width_ = 0.082;           ///< [m] see trackWidth()
   bool wheels_apart_ = false;            ///< the model's driven wheels give the track width
 
+  double drive_wheel_load_ = 0;          ///< [N] see driveWheelLoad()
   double req_left_ = 0, req_right_ = 0;  ///< requested track speeds [m/s]
   double turret_target_ = 0;             ///< [rad]
   bool passive_ = false;

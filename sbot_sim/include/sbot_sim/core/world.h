@@ -2,6 +2,7 @@
 // loop. No ROS here: the simulator node, benchmarks, validation and calibration all drive this class.
 #pragma once
 
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -94,6 +95,17 @@ class World {
   void updateSolverIterations();  ///< after a robot came, went or changed level
   dGeomID queryRay(double length) const;  ///< query_ray_ with this length
   dJointGroupID contacts_ = nullptr;
+  /// This step's contacts on driven treels wheels, with ODE's force feedback (Robot::driveWheelLoad).
+  /// A deque: ODE keeps pointers to the feedback records while the step runs.
+  struct WheelContact {
+    dJointFeedback feedback{};
+    Vec3 normal = Vec3::UnitZ();
+    Robot* wheel_of_body1 = nullptr;  ///< the robot whose driven wheel is the contact's body 1
+    Robot* wheel_of_body2 = nullptr;
+    bool body1_static = false;        ///< ODE then stores the joint reversed (see updateDriveWheelLoads)
+  };
+  std::deque<WheelContact> wheel_contacts_;
+  void updateDriveWheelLoads();       ///< after the step: sum the normal forces per robot
   std::vector<dGeomID> static_geoms_;
   std::map<dGeomID, std::string> static_material_;
   std::vector<std::unique_ptr<Robot>> robots_;
