@@ -511,5 +511,42 @@ std::string restFacts(const std::string& level) {
   return s.str();
 }
 
+Outcome tippingAngle(const std::string& level, bool backward, int iterations) {
+  const RobotDescription& d = loadLevel(level);
+  WorldConfig c = configFor(d, 11);
+  if (iterations > 0) {
+    c.solver_iterations = iterations;
+    c.level_iterations = false;
+  }
+  World w(c);
+  Robot& r = spawn(w, d, {0, 0, backward ? M_PI : 0.0});
+  r.setSpeed(0, 0);
+  w.stepN(static_cast<int>(1.0 / c.step));
+  constexpr double kRate = 1.0;  // [deg/s] slow against the robot's dynamics: quasi-static
+  Outcome o{"upright", 90, 90};  // value: tipping angle, value2: angle at which it slides
+  std::deque<std::pair<Vec3, double>> trail;  // base position and tilt over the last second
+  const std::size_t window = static_cast<std::size_t>(std::lround(1.0 / c.step)) + 1;
+  for (double t = 0; t < 90 / kRate; t += c.step) {
+    const double a = kRate * t * M_PI / 180;
+    dWorldSetGravity(w.odeWorld(), -c.gravity * std::sin(a), 0, -c.gravity * std::cos(a));
+    w.step();
+    // Sliding: 1 cm (scaled) in the last second with the attitude unchanged (within 2 deg: not
+    // the start of a tip). Creep is ~1 mm/s; the instantaneous velocity carries quickstep's jitter.
+    const double tilt = angleBetween(upOf(r), Vec3::UnitZ());
+    trail.push_back({r.basePose().position, tilt});
+    if (trail.size() > window) trail.pop_front();
+    if (o.value2 == 90 && trail.size() == window &&
+        (trail.back().first - trail.front().first).norm() > 0.01 * lengthScale(level) &&
+        std::fabs(trail.back().second - trail.front().second) < 2 * M_PI / 180)
+      o.value2 = kRate * t;
+    if (tilt > 45 * M_PI / 180) {
+      o.label = "tipped";
+      o.value = kRate * t;
+      break;
+    }
+  }
+  return o;
+}
+
 }  // namespace validation
 }  // namespace sbot

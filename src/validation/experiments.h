@@ -60,6 +60,13 @@ Outcome steadySpeedTrial(const std::string& level, int units);
 /// Mass, bodies, centre of mass (base frame and height) and rest attitude on flat ground after 2 s.
 std::string restFacts(const std::string& level);
 
+/// Static tipping angle [deg]: the robot stands (setSpeed(0,0), servos holding) while gravity tilts
+/// by 1 deg/s, rear uphill (`backward`: it tips over its front) or front uphill; the slope at which
+/// it tilts past 45 deg off the slope's normal (value; 90 = did not tip), and the slope at which it
+/// slides 1 cm within a second without tilting (value2; 90 = never). `iterations` > 0 overrides the quickstep iterations (a
+/// converged reference).
+Outcome tippingAngle(const std::string& level, bool backward, int iterations = 0);
+
 /// Run `n` jobs in `processes` forked workers; job i returns fn(i). Results in job order. A job
 /// that crashes or throws yields label "error".
 std::vector<Outcome> runParallel(int n, int processes, const std::function<Outcome(int)>& fn);

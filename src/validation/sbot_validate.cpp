@@ -219,6 +219,20 @@ int main(int argc, char** argv) {
       auto r = v::runParallel(1, 1, [&](int) { return Outcome{v::restFacts(level)}; });
       md << "- " << r[0].label << "\n";
     }
+    md << "\nStatic tipping angle (servos holding, gravity tilted 1 deg/s until the robot tilts 45 deg off "
+          "the slope's normal; rear uphill = it tips over its front, where the 4 cm turret offset puts the "
+          "centre of mass; \"slides\": before tipping, it slid 1 cm within a second without tilting). Quickstep's compliance lowers it; 200 "
+          "iterations are the converged reference.\n\n"
+       << "| level | rear uphill | front uphill | rear uphill, 200 iterations | front uphill, 200 iterations |\n"
+          "|---|---|---|---|---|\n";
+    for (const auto& level : std::vector<std::string>{"fast", "simple", "basic", "medium", "detailed"}) {
+      auto r = v::runParallel(4, o.jobs, [&](int i) { return v::tippingAngle(level, i % 2 == 0, i < 2 ? 0 : 200); });
+      auto deg = [](const Outcome& x) {
+        if (x.value2 < x.value) return "slides from " + fmt(x.value2, 1) + " deg";
+        return x.label == "tipped" ? fmt(x.value, 1) + " deg" : std::string("> 90 deg");
+      };
+      md << "| " << level << " | " << deg(r[0]) << " | " << deg(r[1]) << " | " << deg(r[2]) << " | " << deg(r[3]) << " |\n";
+    }
     md << "\n";
   }
   Tally hw, t45, t46;

@@ -60,3 +60,17 @@ TEST(ValidationDecisive, HardwareCells) {
     }
   }
 }
+
+TEST(ValidationFacts, DetailedTipsOverItsFrontNearTheStaticLimit) {
+  // The centre of mass 1.9 cm ahead of the centre wheels and 4.9 cm above the ground, the front
+  // axle 4 cm ahead: facing downhill the robot tips at atan(0.021 / 0.049) = 23 deg. Quickstep's
+  // compliance at the level's 40 iterations lowers it to ~20 deg (200 iterations: 23.5). Facing
+  // uphill the offset holds it until the treels slide (tan 45 deg = mu 1.0).
+  const auto r = v::runParallel(2, 2, [](int i) { return v::tippingAngle("detailed", i == 0); });
+  EXPECT_EQ(r[0].label, "tipped");
+  EXPECT_GT(r[0].value, 17.0);
+  EXPECT_LT(r[0].value, 24.5);
+  EXPECT_LT(r[1].value2, 48.0) << "front uphill: slides";
+  EXPECT_GT(r[1].value2, 38.0) << "front uphill: slides near atan(mu)";
+  EXPECT_LT(r[1].value2, r[1].value) << "front uphill: slides before it tips";
+}
