@@ -30,15 +30,18 @@
 
 #include "experiments.h"
 #include "two_sbots_trials.h"
+#include "../common/cli_number.h"
 
 namespace {
 
 using namespace two_sbots;
 
-std::vector<double> parseList(const std::string& s) {
+/// A comma-separated list of numbers in [min, max] for `option`.
+std::vector<double> parseList(const std::string& option, const std::string& s, double min, double max) {
   std::vector<double> v;
   std::stringstream ss(s);
-  for (std::string x; std::getline(ss, x, ',');) v.push_back(std::atof(x.c_str()));
+  for (std::string x; std::getline(ss, x, ',');) v.push_back(sbot_tools::numberArg("two_sbots", option, x, min, max));
+  if (v.empty()) sbot_tools::numberArg("two_sbots", option, "", min, max);  // refuses the empty list
   return v;
 }
 
@@ -55,21 +58,13 @@ int main(int argc, char** argv) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
     if (a == "--level") level = next();
-    else if (a == "--trials") trials = std::atoi(next().c_str());
-    else if (a == "--angles") angles = parseList(next());
-    else if (a == "--steps") steps = parseList(next());
+    else if (a == "--trials") trials = sbot_tools::countArg("two_sbots", a, next(), 1, 1000);
+    else if (a == "--angles") angles = parseList(a, next(), 0, 90);    // [deg]
+    else if (a == "--steps") steps = parseList(a, next(), 0, 0.2);     // [m]
     else if (a == "--verbose") verbose = true;
     else if (a == "--seed-friction") setup.seed_friction = true;
     else if (a == "--rear-uphill") setup.rear_uphill = true;
-    else if (a == "--track-mu") {
-      const std::string v = next();
-      char* end = nullptr;
-      setup.track_mu = std::strtod(v.c_str(), &end);
-      if (v.empty() || *end != '\0' || !std::isfinite(setup.track_mu) || setup.track_mu <= 0) {
-        std::fprintf(stderr, "two_sbots: --track-mu expects a positive number, found '%s'\n", v.c_str());
-        return 2;
-      }
-    }
+    else if (a == "--track-mu") setup.track_mu = sbot_tools::numberArg("two_sbots", a, next(), 1e-6, 100);
     else {
       std::fprintf(stderr, "usage: two_sbots [--level L] [--trials N] [--angles deg,...] [--steps m,...] [--verbose] "
                            "[--seed-friction | --track-mu MU] [--rear-uphill]\n");

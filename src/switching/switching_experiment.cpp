@@ -43,6 +43,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "course_run.h"
+#include "../common/cli_number.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/scenario.h"
 #include "sbot_sim/core/swarm/level_policy.h"
@@ -133,12 +134,12 @@ int main(int argc, char** argv) {
     };
     if (a == "--scenario") o.scenario = next();
     else if (a == "--route") o.route = next();
-    else if (a == "--runs") o.runs = std::atoi(next().c_str());
+    else if (a == "--runs") o.runs = sbot_tools::countArg("switching_experiment", a, next(), 1, 1000);
     else if (a == "--out") o.out = next();
-    else if (a == "--jobs") o.jobs = std::atoi(next().c_str());
-    else if (a == "--small-gap-max") o.small_gap_max = std::atof(next().c_str());
-    else if (a == "--lookahead") o.lookahead = std::atof(next().c_str());
-    else if (a == "--demote-delay") o.demote_delay = std::atof(next().c_str());
+    else if (a == "--jobs") o.jobs = sbot_tools::countArg("switching_experiment", a, next(), 1, 64);
+    else if (a == "--small-gap-max") o.small_gap_max = sbot_tools::numberArg("switching_experiment", a, next(), 0, 1);
+    else if (a == "--lookahead") o.lookahead = sbot_tools::numberArg("switching_experiment", a, next(), 0, 10);
+    else if (a == "--demote-delay") o.demote_delay = sbot_tools::numberArg("switching_experiment", a, next(), 0, 1000);
     else if (a == "--modes") {
       o.modes.clear();
       std::stringstream ss(next());

@@ -27,6 +27,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "experiments.h"
+#include "../common/cli_number.h"
 #include "two_sbots_trials.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/world_config.h"
@@ -164,12 +165,12 @@ int main(int argc, char** argv) {
     };
     if (a == "--out") o.out = next();
     else if (a == "--quick") o.quick = true;
-    else if (a == "--trials") o.trials = std::atoi(next().c_str());
-    else if (a == "--jobs") o.jobs = std::atoi(next().c_str());
+    else if (a == "--trials") o.trials = sbot_tools::countArg("sbot_validate", a, next(), 1, 1000);
+    else if (a == "--jobs") o.jobs = sbot_tools::countArg("sbot_validate", a, next(), 1, 64);
     else if (a == "--heightmap") o.heightmap = next();
     else if (a == "--trial") {  // --trial KIND LEVEL PARAM [backward]: one trial, printed (tuning aid)
       const std::string kind = next(), level = next();
-      const double p = std::atof(next().c_str());
+      const double p = sbot_tools::numberArg("sbot_validate", "--trial " + kind + " " + level, next(), -1e6, 1e6);
       Outcome r;
       if (kind == "gap") r = v::gapTrial(level, p, 0);
       else if (kind == "step") r = v::stepTrial(level, p, false, 0);
@@ -180,6 +181,10 @@ int main(int argc, char** argv) {
       else if (kind == "downhill") r = v::downhillTrial(level, p, 0);
       else if (kind == "rough") r = v::roughTrial(level, p, 0, findHeightmap());
       else if (kind == "rtm") r = v::rtmTrial(level, p);
+      else {
+        std::fprintf(stderr, "sbot_validate: --trial expects gap, step, stepb, slope, slopeb, uphill, downhill, rough or rtm, found '%s'\n", kind.c_str());
+        return 2;
+      }
       std::printf("%s %s %g: %s %g %g\n", kind.c_str(), level.c_str(), p, r.label.c_str(), r.value, r.value2);
       return 0;
     }

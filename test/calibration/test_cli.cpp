@@ -2,30 +2,16 @@
 // names them (a misspelt --effects used to be ignored, so `compare --effect F` compared the nominal
 // model), and so are bad values of the ones it does take.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <array>
-#include <cstdio>
 #include <string>
+
+#include "../common/run_process.h"
 
 namespace {
 
-struct Outcome {
-  int status = -1;
-  std::string output;  ///< stdout and stderr
-};
+using Outcome = sbot_test::ProcessOutcome;
 
-Outcome run(const std::string& args) {
-  const std::string cmd = std::string(SBOT_CALIBRATE_BIN) + " " + args + " 2>&1";
-  Outcome o;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return o;
-  std::array<char, 4096> buf{};
-  for (std::size_t n; (n = fread(buf.data(), 1, buf.size(), p)) > 0;) o.output.append(buf.data(), n);
-  const int st = pclose(p);
-  o.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return o;
-}
+Outcome run(const std::string& args) { return sbot_test::runProcess(std::string(SBOT_CALIBRATE_BIN) + " " + args); }
 
 const std::string kExample = std::string(SWARMBOT3D_SOURCE_DIR) + "/datasets/example";
 

@@ -1,0 +1,41 @@
+// The headless tools' numeric options (sbot_validate, switching_experiment, two_sbots): a value that
+// is not a number in range is refused with exit status 2 and a message that names the option and
+// what was found (atoi/atof used to turn "abc" into a silent 0 runs or trials).
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "../common/run_process.h"
+
+namespace {
+
+using Outcome = sbot_test::ProcessOutcome;
+
+Outcome run(const std::string& tool, const std::string& args) {
+  return sbot_test::runProcess(std::string(SWARMBOT3D_BIN_DIR) + "/" + tool + " " + args);
+}
+
+void expectRefused(const std::string& tool, const std::string& args, const std::string& message) {
+  const Outcome o = run(tool, args);
+  EXPECT_EQ(o.status, 2) << tool << " " << args << ": " << o.output;
+  EXPECT_NE(o.output.find(message), std::string::npos) << tool << " " << args << ": " << o.output;
+}
+
+TEST(ToolsCli, NonNumbersAndOutOfRangeValuesAreRefusedByName) {
+  expectRefused("sbot_validate", "--out " + testing::TempDir() + "cli --trials abc", "--trials expects a number in [1, 1000], found 'abc'");
+  expectRefused("sbot_validate", "--trial step detailed x", "--trial step detailed expects a number");
+  expectRefused("sbot_validate", "--trial bogus detailed 1", "found 'bogus'");
+  expectRefused("switching_experiment", "--runs 0", "--runs expects a number in [1, 1000], found '0'");
+  expectRefused("switching_experiment", "--small-gap-max nan", "--small-gap-max expects a number");
+  expectRefused("two_sbots", "--angles 10,x", "--angles expects a number in [0, 90], found 'x'");
+  expectRefused("two_sbots", "--trials 2.5", "--trials expects a whole number, found '2.5'");
+  expectRefused("two_sbots", "--track-mu -1", "--track-mu expects a number");
+}
+
+TEST(ToolsCli, AValidTrialRuns) {
+  const Outcome o = run("sbot_validate", "--trial step detailed 0.010");
+  EXPECT_EQ(o.status, 0) << o.output;
+  EXPECT_NE(o.output.find("step detailed 0.01: pass"), std::string::npos) << o.output;
+}
+
+}  // namespace
