@@ -12,6 +12,7 @@
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/swarm/swarm_graph.h"
 #include "sbot_sim/core/world.h"
+#include "experiments.h"  // kToppledTilt
 
 namespace two_sbots {
 
@@ -73,7 +74,7 @@ SlopeResult pairSlope(const std::string& level, double angle, int trial, const S
       if (grip) grip->update(c.step);
       for (Robot* r : rs) {
         res.max_tilt = std::max(res.max_tilt, tiltOf(*r));
-        if (tiltOf(*r) > 60 * M_PI / 180) toppled = true;
+        if (tiltOf(*r) > sbot::validation::kToppledTilt) toppled = true;
       }
     }
   };

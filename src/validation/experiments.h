@@ -22,6 +22,10 @@ struct Outcome {
   double value2 = 0;        ///< second measurement (heading change [rad], slide [m], ...)
 };
 
+/// Table 4.1 (single and connected s-bots): a robot tilted more than this off the slope's normal has
+/// toppled. Not 60 deg: one tipped forward onto its held gripper rests at 56-59 deg.
+constexpr double kToppledTilt = 45 * 3.14159265358979323846 / 180;  // [rad]
+
 /// Speed used by the seed for gap and slope experiments (4.2.3, 4.2.4): 2.8 cm/s = 10 API units.
 constexpr int kSlowUnits = 10;
 

@@ -252,7 +252,7 @@ int main(int argc, char** argv) {
     md << "## Table 4.1 - single s-bot on a slope (Detailed)\n\n"
        << "Placed on the slope (tilted gravity), motors holding for 3 s, then climbing 8 s at 2.8 cm/s. "
           "full: holds (< 1 cm slide) and climbs at >= 85 % of the commanded speed without rearing up; "
-          "difficult: climbs but slower or rearing > 8 deg; slide: slides down; topple b/w: tilts > 60 deg "
+          "difficult: climbs but slower or rearing > 8 deg; slide: slides down; topple b/w: tilts > 45 deg "
           "off the slope normal.\n\n"
        << "Orientation: **rear uphill** (the robot climbs in reverse, gripper and 4 cm turret COM offset "
           "downhill) is the matching condition; **front uphill** is shown as well. The seed does not say "
