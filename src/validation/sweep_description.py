@@ -1,0 +1,164 @@
+#!/usr/bin/python3
+"""Run validation sections on variants of the s-bot parameter table (a tuning aid).
+
+    sweep_description.py [--set PATH=VALUE ...] [--grid PATH=V1,V2,... ...]
+                         [--only 4.1,4.2,4.3] [--trials 3] [--keep DIR]
+
+Each variant is the table (sbot_description/config/sbot_parameters.yaml) with the --set values and
+one combination of the --grid values applied. Its URDFs and sidecars are generated into a directory
+of their own, and `sbot_validate` runs the sections on them through $SBOT_DESCRIPTION_DIR, so the
+source tree is never touched. One line per variant: the cells matched per table and the mismatched
+cells.
+
+PATH is a dotted path into the table, with [i] for list elements, e.g.
+  --grid 'levels.medium.turret.com_m[0]=0.030,0.035,0.040'   (Detailed inherits Medium's turret)
+VALUE is YAML: 0.03, [0.03, 0, 0.011], true, text.
+
+Runs $SBOT_VALIDATE if set, else this tree's build/ws/devel/lib/swarmbot3d/sbot_validate, else
+`rosrun swarmbot3d sbot_validate`. Needs /usr/bin/python3 with PyYAML.
+"""
+import argparse
+import itertools
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+import yaml
+
+HERE = os.path.dirname(os.path.realpath(__file__))  # the source tree, also when run through the workspace links
+ROOT = os.path.dirname(os.path.dirname(HERE))
+DESCRIPTION = os.path.join(ROOT, "sbot_description")
+TABLE = os.path.join(DESCRIPTION, "config", "sbot_parameters.yaml")
+GENERATOR = os.path.join(DESCRIPTION, "scripts", "generate_urdf.py")
+
+_STEP = re.compile(r"([^.\[\]]+)|\[(\d+)\]")
+
+
+def path_steps(path):
+    """'levels.medium.turret.com_m[0]' -> ['levels', 'medium', 'turret', 'com_m', 0]."""
+    steps, pos = [], 0
+    for m in _STEP.finditer(path):
+        if m.start() != pos and path[pos:m.start()] != ".":
+            raise ValueError("cannot read path '%s' at '%s'" % (path, path[pos:]))
+        steps.append(m.group(1) if m.group(1) is not None else int(m.group(2)))
+        pos = m.end()
+    if not steps or pos != len(path):
+        raise ValueError("cannot read path '%s'" % path)
+    return steps
+
+
+def set_value(table, path, value):
+    """Replace an existing entry; a path that names nothing in the table is an error (typos)."""
+    node = table
+    steps = path_steps(path)
+    for i, step in enumerate(steps):
+        last = i == len(steps) - 1
+        if isinstance(step, int):
+            if not isinstance(node, list) or step >= len(node):
+                raise ValueError("%s: element [%d] does not exist" % (path, step))
+        elif not isinstance(node, dict) or step not in node:
+            known = ", ".join(sorted(node)) if isinstance(node, dict) else "(not a mapping)"
+            raise ValueError("%s: '%s' is not in the table here; known: %s" % (path, step, known))
+        if last:
+            node[step] = value
+        else:
+            node = node[step]
+
+
+def parse_assignment(text, many):
+    if "=" not in text:
+        raise ValueError("expected PATH=VALUE, found '%s'" % text)
+    path, value = text.split("=", 1)
+    values = [yaml.safe_load(v) for v in value.split(",")] if many else [yaml.safe_load(value)]
+    path_steps(path)  # refuse a malformed path before anything runs
+    return path.strip(), values
+
+
+def summary(report_md):
+    """'hardware 12/16, 4.5 21/28, ...' and the mismatched rows of a report."""
+    with open(report_md, encoding="utf-8") as fh:
+        text = fh.read()
+    counts = re.findall(r"^- (Hardware cells of Tables 4.1-4.3|Table 4.5 cells|Table 4.6 cells) matched: (\d+/\d+)",
+                        text, re.M)
+    names = {"Hardware cells of Tables 4.1-4.3": "hardware", "Table 4.5 cells": "4.5", "Table 4.6 cells": "4.6"}
+    tally = ", ".join("%s %s" % (names[n], c) for n, c in counts)
+    missed = [" | ".join(c.strip() for c in row.strip().strip("|").split("|") if "mismatch" not in c)
+              for row in text.splitlines() if row.startswith("| ") and "**mismatch**" in row]
+    return tally, missed
+
+
+def validate_command():
+    """$SBOT_VALIDATE, else this tree's build (./sbot.sh build), else rosrun."""
+    if os.environ.get("SBOT_VALIDATE"):
+        return [os.environ["SBOT_VALIDATE"]]
+    local = os.path.join(ROOT, "build", "ws", "devel", "lib", "swarmbot3d", "sbot_validate")
+    return [local] if os.access(local, os.X_OK) else ["rosrun", "swarmbot3d", "sbot_validate"]
+
+
+def run_variant(table, only, trials, workdir):
+    os.makedirs(os.path.join(workdir, "urdf"))
+    shutil.copytree(os.path.join(DESCRIPTION, "config"), os.path.join(workdir, "config"))
+    params = os.path.join(workdir, "params.yaml")
+    with open(params, "w", encoding="utf-8") as fh:
+        yaml.safe_dump(table, fh, sort_keys=False)
+    gen = subprocess.run(["/usr/bin/python3", GENERATOR, "--out", os.path.join(workdir, "urdf"), "--params", params,
+                          "--quiet"], capture_output=True, text=True)
+    if gen.returncode != 0:
+        return "generator failed: " + (gen.stderr.strip().splitlines() or ["?"])[-1], []
+    env = dict(os.environ, SBOT_DESCRIPTION_DIR=workdir)
+    out = os.path.join(workdir, "report")
+    val = subprocess.run(validate_command() + ["--out", out, "--only", only, "--trials", str(trials)], env=env,
+                         capture_output=True, text=True)
+    report = os.path.join(out, "report.md")
+    if not os.path.exists(report):
+        return "sbot_validate failed (status %d): %s" % (val.returncode, val.stderr.strip()[-300:]), []
+    return summary(report)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--set", action="append", default=[], metavar="PATH=VALUE")
+    ap.add_argument("--grid", action="append", default=[], metavar="PATH=V1,V2,...")
+    ap.add_argument("--only", default="4.1,4.2,4.3", help="sbot_validate sections (default 4.1,4.2,4.3)")
+    ap.add_argument("--trials", type=int, default=3, help="trials per cell (default 3)")
+    ap.add_argument("--keep", help="keep every variant's files (params, URDFs, report) under this directory")
+    a = ap.parse_args()
+    if a.trials < 1:
+        ap.error("--trials expects a whole number >= 1, found %d" % a.trials)
+    try:
+        fixed = [parse_assignment(s, False) for s in a.set]
+        grid = [parse_assignment(g, True) for g in a.grid]
+        with open(TABLE, encoding="utf-8") as fh:
+            base = yaml.safe_load(fh)
+        for path, (value,) in fixed:
+            set_value(base, path, value)
+        # Validate every grid path once before running anything.
+        for path, values in grid:
+            set_value(yaml.safe_load(yaml.safe_dump(base)), path, values[0])
+    except (OSError, ValueError, yaml.YAMLError) as e:
+        print("sweep_description: %s" % e, file=sys.stderr)
+        return 2
+    root = a.keep or tempfile.mkdtemp(prefix="sbot_sweep_")
+    os.makedirs(root, exist_ok=True)
+    combos = list(itertools.product(*[values for _, values in grid])) or [()]
+    print("%d variant(s); sections %s, %d trial(s) per cell; files in %s" % (len(combos), a.only, a.trials, root))
+    for n, combo in enumerate(combos):
+        table = yaml.safe_load(yaml.safe_dump(base))
+        label = ", ".join("%s=%s" % (path, v) for (path, _), v in zip(grid, combo)) or "table as set"
+        for (path, _), v in zip(grid, combo):
+            set_value(table, path, v)
+        tally, missed = run_variant(table, a.only, a.trials, os.path.join(root, "variant_%03d" % n))
+        print("%s: %s" % (label, tally))
+        for m in missed:
+            print("    mismatch: %s" % m)
+        sys.stdout.flush()
+    if not a.keep:
+        shutil.rmtree(root, ignore_errors=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

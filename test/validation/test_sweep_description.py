@@ -1,0 +1,45 @@
+#!/usr/bin/python3
+"""sweep_description.py: a variant's value reaches the generated URDF that sbot_validate runs on, and
+a path that names nothing in the parameter table is refused by name before anything runs."""
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import unittest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
+TOOL = os.path.join(ROOT, "src", "validation", "sweep_description.py")
+
+
+def sweep(*args):
+    return subprocess.run(["/usr/bin/python3", TOOL] + list(args), capture_output=True, text=True)
+
+
+class SweepDescription(unittest.TestCase):
+    def test_a_grid_value_reaches_the_model_and_the_report(self):
+        keep = tempfile.mkdtemp(prefix="sweep_test_")
+        r = sweep("--grid", "levels.medium.turret.com_m[0]=0.031,0.049", "--only", "4.2", "--trials", "1",
+                  "--keep", keep)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("2 variant(s)", r.stdout)
+        self.assertRegex(r.stdout, r"com_m\[0\]=0.031: hardware \d+/3")
+        for n, x in ((0, "0.031"), (1, "0.049")):
+            with open(os.path.join(keep, "variant_%03d" % n, "urdf", "detailed.urdf"), encoding="utf-8") as fh:
+                urdf = fh.read()
+            turret = urdf[urdf.index('<link name="turret">'):]
+            self.assertRegex(turret[:400], r'<origin xyz="%s 0 ' % re.escape(x))
+            self.assertTrue(os.path.exists(os.path.join(keep, "variant_%03d" % n, "report", "report.md")))
+
+    def test_a_misspelt_path_is_refused_by_name(self):
+        r = sweep("--grid", "levels.medium.turet.com_m[0]=0.03")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("'turet' is not in the table", r.stderr)
+        self.assertIn("turret", r.stderr, "lists the keys that exist")
+        r = sweep("--set", "levels.medium.turret.com_m[9]=0.03")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("element [9] does not exist", r.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main(argv=[sys.argv[0], "-v"])
