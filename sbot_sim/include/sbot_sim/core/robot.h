@@ -82,8 +82,8 @@ class Robot {
   double trackTorqueRight() const;
   /// Normal force the surroundings (ground, obstacles, other robots) exerted on the driven
   /// treels wheels in the last step [N]: the load the tracks can grip with. About the robot's
-  /// weight on flat ground; near 0 when it is airborne or hung up on its chassis or casters
-  /// (the body drive's traction and the validation's "stuck" versus "slipping" use it).
+  /// weight on flat ground; near 0 when it is airborne or hung up on its chassis or casters (the
+  /// validation's Table 4.6 tells "stuck" from "slipping" by it). Fast's body drive does not use it.
   double driveWheelLoad() const { return drive_wheel_load_; }
   /// Turret angle [rad] relative to the treels.
   double turretAngle() const;
