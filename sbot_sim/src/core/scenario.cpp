@@ -10,9 +10,13 @@
 
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/robot_description.h"
+#include "sbot_sim/core/world.h"  // robotNameProblem
 
 namespace sbot {
 namespace {
+
+/// Seeds are whole numbers a double holds exactly.
+constexpr long long kMaxSeed = 1LL << 53;
 
 // Reads typed fields of one YAML mapping and reports errors with the full dotted field path.
 class Fields {
@@ -44,6 +48,18 @@ class Fields {
     if (!(v > 0)) throw ConfigError(file_, path(key), "must be > 0");
     return v;
   }
+  double within(const std::string& key, double fallback, double lo, double hi) const {
+    const double v = number(key, fallback);
+    if (v < lo || v > hi) throw ConfigError(file_, path(key), "must be in [" + fmt(lo) + ", " + fmt(hi) + "], found " + fmt(v));
+    return v;
+  }
+  /// A whole number in [lo, hi] (counts, iterations, seeds: a cast would wrap or truncate silently).
+  long long integer(const std::string& key, long long fallback, long long lo, long long hi) const {
+    const double v = number(key, static_cast<double>(fallback));
+    if (v != std::floor(v) || v < lo || v > hi)
+      throw ConfigError(file_, path(key), "must be a whole number in [" + fmt(lo) + ", " + fmt(hi) + "], found " + fmt(v));
+    return static_cast<long long>(v);
+  }
   std::string text(const std::string& key, const std::string& fallback) const {
     if (!has(key)) return fallback;
     if (!node_[key].IsScalar()) throw ConfigError(file_, path(key), "expected a string");
@@ -58,18 +74,16 @@ class Fields {
     }
   }
   Vec3 vec3(const std::string& key, const Vec3& fallback) const {
-    if (!has(key)) return fallback;
-    const YAML::Node n = node_[key];
-    if (!n.IsSequence() || n.size() != 3) throw ConfigError(file_, path(key), "expected [x, y, z]");
-    Vec3 v;
-    for (int i = 0; i < 3; ++i) {
-      try {
-        v[i] = n[i].as<double>();
-      } catch (const YAML::Exception&) {
-        throw ConfigError(file_, path(key), "expected three numbers");
-      }
-    }
+    Vec3 v = fallback;
+    numbers(key, 3, "[x, y, z]", v.data());
     return v;
+  }
+  /// [x, y]; absent: `fallback`.
+  void xy(const std::string& key, double* x, double* y) const {
+    double v[2] = {*x, *y};
+    numbers(key, 2, "[x, y]", v);
+    *x = v[0];
+    *y = v[1];
   }
   /// Typos in scenario files should not be silently ignored.
   void allowOnly(const std::set<std::string>& keys) const {
@@ -87,6 +101,26 @@ class Fields {
  private:
   std::string scalar(const std::string& key) const {
     return node_[key].IsScalar() ? node_[key].as<std::string>() : "<not a scalar>";
+  }
+  static std::string fmt(double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+  }
+  /// A list of exactly `n` finite numbers into out[0..n); absent: out unchanged.
+  void numbers(const std::string& key, int n, const char* shape, double* out) const {
+    if (!has(key)) return;
+    const YAML::Node list = node_[key];
+    if (!list.IsSequence() || static_cast<int>(list.size()) != n)
+      throw ConfigError(file_, path(key), std::string("expected ") + shape);
+    for (int i = 0; i < n; ++i) {
+      try {
+        out[i] = list[i].as<double>();
+      } catch (const YAML::Exception&) {
+        throw ConfigError(file_, path(key), std::string("expected ") + shape + " of numbers");
+      }
+      if (!std::isfinite(out[i])) throw ConfigError(file_, path(key), "must be finite");
+    }
   }
   YAML::Node node_;
   bool present_;
@@ -122,14 +156,14 @@ void parseTerrain(const YAML::Node& n, TerrainConfig& t, const std::string& file
     const auto slash = file.find_last_of('/');
     if (slash != std::string::npos) t.heightmap_image = file.substr(0, slash + 1) + t.heightmap_image;
   }
-  t.resolution = static_cast<int>(f.number("resolution", t.resolution));
+  t.resolution = static_cast<int>(f.integer("resolution", t.resolution, 8, 4096));
   if (f.has("size")) {
     const double s = f.positive("size", 5.0);
     t.size_x = t.size_y = s;
   }
   t.height_range = f.number("height_range", 0.0);
   if (t.height_range < 0) throw ConfigError(file, f.path("height_range"), "must be >= 0");
-  t.heightmap_seed = static_cast<std::uint64_t>(f.number("seed", 1));
+  t.heightmap_seed = static_cast<std::uint64_t>(f.integer("seed", 1, 0, kMaxSeed));
 
   if (const YAML::Node boxes = f.node("boxes")) {
     if (!boxes.IsSequence()) throw ConfigError(file, f.path("boxes"), "expected a list");
@@ -170,7 +204,8 @@ void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
     throw ConfigError(file, f.path("solver"), "expected 'quickstep' or 'exact', found '" + w.solver + "'");
   w.step = f.positive("step", w.step);
   w.gravity = f.number("gravity", w.gravity);
-  w.solver_iterations = static_cast<int>(f.positive("solver_iterations", w.solver_iterations));
+  if (w.gravity < 0) throw ConfigError(file, f.path("gravity"), "must be >= 0 (its magnitude: gravity points along -z)");
+  w.solver_iterations = static_cast<int>(f.integer("solver_iterations", w.solver_iterations, 1, 100000));
   w.solver_sor = f.positive("solver_sor", w.solver_sor);
   w.lock_idle_turret = f.flag("lock_idle_turret", w.lock_idle_turret);
   if (const YAML::Node c = f.node("contact")) {
@@ -178,14 +213,20 @@ void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
     cf.allowOnly({"mu", "erp", "cfm", "bounce", "max_contacts", "coulomb", "materials"});
     w.contact.mu = cf.number("mu", w.contact.mu);
     if (w.contact.mu < 0) throw ConfigError(file, cf.path("mu"), "must be >= 0");
-    w.contact.erp = cf.number("erp", w.contact.erp);
+    w.contact.erp = cf.within("erp", w.contact.erp, 0, 1);
     w.contact.cfm = cf.number("cfm", w.contact.cfm);
-    w.contact.bounce = cf.number("bounce", w.contact.bounce);
-    w.contact.max_contacts = static_cast<int>(cf.positive("max_contacts", w.contact.max_contacts));
+    if (w.contact.cfm < 0) throw ConfigError(file, cf.path("cfm"), "must be >= 0");
+    w.contact.bounce = cf.within("bounce", w.contact.bounce, 0, 1);
+    // World::handlePair collects at most 16 contacts per geom pair.
+    w.contact.max_contacts = static_cast<int>(cf.integer("max_contacts", w.contact.max_contacts, 1, 16));
     w.contact.coulomb = cf.flag("coulomb", w.contact.coulomb);
     if (const YAML::Node m = cf.node("materials")) {
       Fields mf(m, "world.contact.materials", file);
-      for (const auto& kv : m) w.contact.material_mu[kv.first.as<std::string>()] = mf.number(kv.first.as<std::string>(), 0);
+      for (const auto& kv : m) {
+        const std::string material = kv.first.as<std::string>();
+        w.contact.material_mu[material] = mf.number(material, 0);
+        if (w.contact.material_mu[material] < 0) throw ConfigError(file, mf.path(material), "must be >= 0");
+      }
     }
   }
   parseTerrain(f.node("terrain"), w.terrain, file);
@@ -194,6 +235,9 @@ void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
 }  // namespace
 
 Scenario parseScenario(const std::string& yaml_text, const std::string& file, int robot_count) {
+  if (robot_count > kMaxRobots)
+    throw ConfigError(file, "swarm.count", "robot count override " + std::to_string(robot_count) + " exceeds " +
+                                               std::to_string(kMaxRobots));
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
@@ -205,9 +249,7 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
   f.allowOnly({"seed", "duration", "world", "robots", "swarm", "links", "name", "description", "effects"});
   Scenario s;
   s.source = file;
-  const double seed = f.number("seed", 1);
-  if (seed < 0 || seed != std::floor(seed)) throw ConfigError(file, "seed", "must be a non-negative integer");
-  s.world.seed = static_cast<std::uint64_t>(seed);
+  s.world.seed = static_cast<std::uint64_t>(f.integer("seed", 1, 0, kMaxSeed));
   s.duration = f.number("duration", 0);
   s.effects_file = f.text("effects", "");
   if (!s.effects_file.empty() && s.effects_file[0] != '/') {
@@ -225,6 +267,8 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
       r.allowOnly({"name", "level", "pose"});
       RobotSpawn spawn;
       spawn.name = r.text("name", "sbot_" + std::to_string(i));
+      const std::string problem = robotNameProblem(spawn.name);
+      if (!problem.empty()) throw ConfigError(file, r.path("name"), problem);
       spawn.level = checkLevel(r.text("level", "simple"), file, r.path("level"));
       spawn.pose = parsePose(r.node("pose"), r.path("pose"), file);
       s.robots.push_back(spawn);
@@ -233,19 +277,12 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
   if (const YAML::Node swarm = f.node("swarm")) {
     Fields sw(swarm, "swarm", file);
     sw.allowOnly({"count", "level", "layout", "spacing", "center", "area"});
-    const double count_d = sw.number("count", 0);
-    if (count_d < 0 || count_d != std::floor(count_d)) throw ConfigError(file, "swarm.count", "must be a non-negative integer");
-    const int count = robot_count >= 0 ? robot_count : static_cast<int>(count_d);
+    const int count = robot_count >= 0 ? robot_count : static_cast<int>(sw.integer("count", 0, 0, kMaxRobots));
     const std::string level = checkLevel(sw.text("level", "simple"), file, "swarm.level");
     const std::string layout = sw.text("layout", "grid");
     const double spacing = sw.positive("spacing", 0.3);
     double cx = 0, cy = 0;
-    if (sw.has("center")) {
-      const YAML::Node c = swarm["center"];
-      if (!c.IsSequence() || c.size() != 2) throw ConfigError(file, "swarm.center", "expected [x, y]");
-      cx = c[0].as<double>();
-      cy = c[1].as<double>();
-    }
+    sw.xy("center", &cx, &cy);
     const int side = std::max(1, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(count)))));
     std::mt19937_64 rng(s.world.seed * 7919 + 17);
     const double area = sw.positive("area", side * spacing);

@@ -146,8 +146,19 @@ Robot& World::addRobot(const RobotDescription& description, const Pose2D& pose, 
   return r;
 }
 
+std::string robotNameProblem(const std::string& name) {
+  const auto letter = [](char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'); };
+  const auto digit = [](char c) { return c >= '0' && c <= '9'; };
+  bool ok = !name.empty() && letter(name[0]);
+  for (char c : name) ok = ok && (letter(c) || digit(c) || c == '_');
+  if (ok) return "";
+  return "invalid robot name '" + name + "' (a ROS name: a letter, then letters, digits or '_')";
+}
+
 Robot& World::addRobotAt(const RobotDescription& description, const Pose& pose, const std::string& name) {
   if (findRobot(name)) throw ConfigError("<world>", "robots", "duplicate robot name '" + name + "'");
+  const std::string problem = robotNameProblem(name);
+  if (!problem.empty()) throw ConfigError("<world>", "robots", problem);
   robots_.push_back(std::make_unique<Robot>(*this, description, name, next_index_++, pose));
   updateSolverIterations();
   return *robots_.back();

@@ -184,8 +184,9 @@ bool SwarmRosInterface::onSpawn(sbot_msgs::Spawn::Request& req, sbot_msgs::Spawn
     res.message = "no world (a reset failed)";
     return true;
   }
-  if (req.name.empty() || req.name.find_first_of(" /\t\n") != std::string::npos) {
-    res.message = "invalid robot name '" + req.name + "' (non-empty, no spaces or slashes)";
+  const std::string name_problem = sbot::robotNameProblem(req.name);
+  if (!name_problem.empty()) {
+    res.message = name_problem;
     return true;
   }
   if (world_->findRobot(req.name)) {

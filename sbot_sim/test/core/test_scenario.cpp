@@ -2,7 +2,9 @@
 #include <gtest/gtest.h>
 
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/scenario.h"
+#include "sbot_sim/core/world.h"
 
 namespace sbot {
 namespace {
@@ -61,6 +63,49 @@ TEST(Scenario, ErrorsNameFileAndField) {
   EXPECT_NE(errorOf("seed: [1").find("bad.yaml: not valid YAML"), std::string::npos);
   EXPECT_NE(errorOf("robots: [{name: a}, {name: a}]").find("duplicate robot name 'a'"), std::string::npos);
   EXPECT_NE(errorOf("world: {gravity: .nan}").find("'world.gravity': must be finite"), std::string::npos);
+}
+
+// Values that parsed but then misbehaved: an int cast that wrapped (solver_iterations 1e12), a
+// count that exhausted memory (1e8 robots, resolution 1e5), a name ROS cannot advertise topics
+// under, a gravity pointing up, contact softness outside ODE's ranges.
+TEST(Scenario, RefusesValuesThatWouldMisbehaveLater) {
+  const auto refused = [](const std::string& yaml, const std::string& expected) {
+    const std::string e = errorOf(yaml);
+    EXPECT_NE(e.find(expected), std::string::npos) << yaml << "\n  gave: '" << e << "'";
+  };
+  refused("world: {solver_iterations: 1e12}", "'world.solver_iterations': must be a whole number in [1, 100000], found 1e+12");
+  refused("world: {solver_iterations: 2.5}", "'world.solver_iterations': must be a whole number");
+  refused("swarm: {count: 100000000}", "'swarm.count': must be a whole number in [0, 10000]");
+  refused("seed: -1", "'seed': must be a whole number in [0, ");
+  refused("world: {terrain: {type: rough, resolution: 100000}}", "'world.terrain.resolution': must be a whole number in [8, 4096]");
+  refused("world: {terrain: {type: rough, seed: 0.5}}", "'world.terrain.seed': must be a whole number");
+  refused("world: {gravity: -9.81}", "'world.gravity': must be >= 0");
+  refused("world: {contact: {erp: 5}}", "'world.contact.erp': must be in [0, 1], found 5");
+  refused("world: {contact: {cfm: -1}}", "'world.contact.cfm': must be >= 0");
+  refused("world: {contact: {bounce: 2}}", "'world.contact.bounce': must be in [0, 1]");
+  refused("world: {contact: {max_contacts: 17}}", "'world.contact.max_contacts': must be a whole number in [1, 16]");
+  refused("world: {contact: {materials: {track: -1}}}", "'world.contact.materials.track': must be >= 0");
+  refused("swarm: {count: 2, center: [0, .nan]}", "'swarm.center': must be finite");
+  refused("swarm: {count: 2, center: [0, here]}", "'swarm.center': expected [x, y] of numbers");
+  refused("world: {terrain: {type: composite, boxes: [{center: [0, 0]}]}}", "'world.terrain.boxes[0].center': expected [x, y, z]");
+  for (const std::string name : {"", "1abc", "a b", "a-b", "sbot/x"})
+    refused("robots: [{name: '" + name + "'}]", "'robots[0].name': invalid robot name '" + name + "'");
+  EXPECT_EQ(parseScenario("robots: [{name: Leader_2}]", "ok.yaml").robots[0].name, "Leader_2");
+  try {
+    parseScenario("swarm: {count: 3}", "big.yaml", kMaxRobots + 1);
+    ADD_FAILURE() << "a robot count override above kMaxRobots was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("exceeds 10000"), std::string::npos) << e.what();
+  }
+}
+
+// The same rule guards the other way robots enter a world (the node's /sim/spawn, tools).
+TEST(Scenario, TheWorldRefusesRobotNamesRosCannotUse) {
+  World w(WorldConfig{});
+  EXPECT_THROW(w.addRobot(loadLevel("simple"), {0, 0, 0}, "2nd"), ConfigError);
+  EXPECT_THROW(w.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot 1"), ConfigError);
+  EXPECT_EQ(w.robots().size(), 0u) << "nothing half-built is left behind";
+  EXPECT_NO_THROW(w.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_1"));
 }
 
 TEST(Scenario, EffectsFileIsRelativeToTheScenario) {

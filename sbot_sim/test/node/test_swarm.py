@@ -99,6 +99,10 @@ class TestSwarm(unittest.TestCase):
         self.assertFalse(res.success)
         res = self.spawn('sbot_9', 'simple', float('nan'), 1.0, 0.0)
         self.assertFalse(res.success)
+        for name in ('', '9lives', 'sbot-9', 'sbot 9', 'a/b'):  # ROS could not advertise its topics
+            res = self.spawn(name, 'simple', 1.0, 1.0, 0.0)
+            self.assertFalse(res.success, name)
+            self.assertIn("invalid robot name '%s'" % name, res.message)
         res = self.delete('sbot_42')
         self.assertFalse(res.success)
         self.assertIn("unknown robot 'sbot_42'", res.message)

@@ -12,7 +12,7 @@
 //       boxes: [{name: wall_n, center: [0, 2, 0.05], size: [4, 0.02, 0.1], yaw: 0, surface: white_paper}]
 //       arena: {size: 4.0, height: 0.1}   # shorthand: four walls around the origin
 //   robots:                       # explicit robots ...
-//     - {name: sbot_0, level: simple, pose: {x: 0, y: 0, yaw: 0}}
+//     - {name: sbot_0, level: simple, pose: {x: 0, y: 0, yaw: 0}}   # name: see robotNameProblem
 //   swarm:                        # ... and/or generated ones, named sbot_<i> after the explicit ones
 //     {count: 20, level: simple, layout: grid, spacing: 0.3, center: [0, 0]}   # layout grid|random
 //   world.lamps: [{position: [x, y, z], intensity: mcd, colour: [r, g, b]}]   # read by the node
@@ -29,6 +29,10 @@
 #include "sbot_sim/core/world_config.h"
 
 namespace sbot {
+
+/// The most robots a scenario may spawn (swarm.count, or the node's ~robots override): a typo such
+/// as `count: 1e8` then fails with a message instead of exhausting the machine's memory.
+constexpr int kMaxRobots = 10000;
 
 struct RobotSpawn {
   std::string name;

@@ -25,6 +25,11 @@ struct RayHit {
   const Robot* robot = nullptr;///< the robot hit, if any
 };
 
+/// What is wrong with `name` as a robot name, or "" when it is valid. Robot names become ROS
+/// namespaces and TF prefixes (`<name>/proximity`, `<name>/base_link`), so they follow the ROS graph
+/// name rules for one segment: a letter, then letters, digits or '_'.
+std::string robotNameProblem(const std::string& name);
+
 class World {
  public:
   explicit World(const WorldConfig& config);
@@ -34,7 +39,7 @@ class World {
 
   /// Spawn a robot of `description` with base_link at `pose` (x, y, yaw) resting on the terrain.
   Robot& addRobot(const RobotDescription& description, const Pose2D& pose, const std::string& name);
-  /// Spawn at an explicit 3D pose of base_link.
+  /// Spawn at an explicit 3D pose of base_link. Both refuse (ConfigError) a duplicate or invalid name.
   Robot& addRobotAt(const RobotDescription& description, const Pose& pose, const std::string& name);
   void removeRobot(const std::string& name);
   /// Dynamic model switching (seed 2.1.3): rebuild robot `name` from `description` in place, keeping
