@@ -1,5 +1,6 @@
 #include "sbot_sim/core/robot_description.h"
 
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <mutex>
@@ -31,40 +32,95 @@ std::string readFile(const std::string& path) {
   return ss.str();
 }
 
-LinkDescription convertLink(const urdf::Link& link, const std::string& file) {
+/// The XML of `<link name="NAME" ...>` up to its end, comments removed ("" if not found).
+std::string linkXml(const std::string& xml, const std::string& name) {
+  std::string text;  // without <!-- comments -->
+  for (std::size_t i = 0; i < xml.size();) {
+    const std::size_t c = xml.find("<!--", i);
+    text += xml.substr(i, c == std::string::npos ? std::string::npos : c - i);
+    if (c == std::string::npos) break;
+    const std::size_t e = xml.find("-->", c + 4);
+    i = e == std::string::npos ? xml.size() : e + 3;
+  }
+  for (const char q : {'"', '\''}) {
+    const std::size_t start = text.find("<link name=" + std::string(1, q) + name + q);
+    if (start == std::string::npos) continue;
+    const std::size_t open_end = text.find('>', start);
+    if (open_end == std::string::npos) return "";
+    if (text[open_end - 1] == '/') return text.substr(start, open_end + 1 - start);  // <link .../>
+    const std::size_t end = text.find("</link>", open_end);
+    return text.substr(start, end == std::string::npos ? std::string::npos : end - start);
+  }
+  return "";
+}
+
+std::size_t countTags(const std::string& xml, const std::string& tag) {
+  std::size_t n = 0;
+  for (std::size_t i = xml.find("<" + tag); i != std::string::npos; i = xml.find("<" + tag, i + 1)) {
+    const char next = i + 1 + tag.size() < xml.size() ? xml[i + 1 + tag.size()] : '>';
+    n += (next == '>' || next == ' ' || next == '/' || next == '\n' || next == '\t' || next == '\r');
+  }
+  return n;
+}
+
+void requirePositive(double v, const std::string& file, const std::string& field) {
+  if (!(std::isfinite(v) && v > 0)) throw ConfigError(file, field, "must be a finite number > 0");
+}
+
+LinkDescription convertLink(const urdf::Link& link, const std::string& xml, const std::string& file) {
   LinkDescription out;
   out.name = link.name;
+  // urdfdom drops an <inertial> or <collision> it cannot parse (mass="nan", radius="x") with only
+  // a message on stderr; the link would then load massless or without that shape.
+  const std::string own = linkXml(xml, link.name);
+  if (!own.empty()) {
+    const std::size_t inertials = countTags(own, "inertial"), collisions = countTags(own, "collision");
+    if (inertials != (link.inertial ? 1u : 0u) || collisions != link.collision_array.size())
+      throw ConfigError(file, "link " + link.name,
+                        "urdfdom could not parse all of it: it kept " + std::to_string(link.inertial ? 1 : 0) + " of " +
+                            std::to_string(inertials) + " <inertial> and " + std::to_string(link.collision_array.size()) +
+                            " of " + std::to_string(collisions) + " <collision> elements (its message is printed above)");
+  }
   if (link.inertial) {
     const urdf::Inertial& in = *link.inertial;
-    if (!(in.mass >= 0)) throw ConfigError(file, "link " + link.name + "/inertial/mass", "must be >= 0");
+    if (!(std::isfinite(in.mass) && in.mass >= 0))
+      throw ConfigError(file, "link " + link.name + "/inertial/mass", "must be a finite number >= 0");
     out.mass = in.mass;
     out.inertial_origin = toPose(in.origin);
     out.inertia << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
+    if (!out.inertia.allFinite())
+      throw ConfigError(file, "link " + link.name + "/inertial/inertia", "must be finite");
     if (in.mass > 0 && (in.ixx <= 0 || in.iyy <= 0 || in.izz <= 0)) {
       throw ConfigError(file, "link " + link.name + "/inertial/inertia",
                         "diagonal inertia must be positive for a link with mass");
     }
   }
   for (const auto& col : link.collision_array) {
-    if (!col || !col->geometry) continue;
+    if (!col || !col->geometry)
+      throw ConfigError(file, "link " + link.name + "/collision", "has no geometry");
+    const std::string field = "link " + link.name + "/collision/geometry";
     CollisionShape shape;
     shape.origin = toPose(col->origin);
     switch (col->geometry->type) {
       case urdf::Geometry::SPHERE:
         shape.type = CollisionShape::Type::Sphere;
         shape.radius = static_cast<const urdf::Sphere&>(*col->geometry).radius;
+        requirePositive(shape.radius, file, field + "/sphere radius");
         break;
       case urdf::Geometry::CYLINDER: {
         const auto& c = static_cast<const urdf::Cylinder&>(*col->geometry);
         shape.type = CollisionShape::Type::Cylinder;
         shape.radius = c.radius;
         shape.length = c.length;
+        requirePositive(shape.radius, file, field + "/cylinder radius");
+        requirePositive(shape.length, file, field + "/cylinder length");
         break;
       }
       case urdf::Geometry::BOX: {
         const auto& b = static_cast<const urdf::Box&>(*col->geometry);
         shape.type = CollisionShape::Type::Box;
         shape.size = Vec3(b.dim.x, b.dim.y, b.dim.z);
+        for (int k = 0; k < 3; ++k) requirePositive(shape.size[k], file, field + "/box size");
         break;
       }
       default:
@@ -148,14 +204,28 @@ void parseSidecar(RobotDescription& d) {
   tr.rotor_inertia = get<double>(t, "rotor_inertia", tr.rotor_inertia, file, "treels.");
   tr.backdrive_force = get<double>(t, "backdrive_force", tr.backdrive_force, file, "treels.");
   tr.torque_window = get<double>(t, "torque_window", tr.torque_window, file, "treels.");
-  if (tr.rotor_inertia < 0) throw ConfigError(file, "treels.rotor_inertia", "must be >= 0");
-  if (!(tr.torque_window >= 0)) throw ConfigError(file, "treels.torque_window", "must be >= 0 [s]");
+  // Every number below divides, scales or limits a motor: NaN, 0 or a sign error would silently
+  // give a robot that cannot drive or one that explodes.
+  const auto nonNegative = [&](double v, const std::string& field) {
+    if (!(std::isfinite(v) && v >= 0)) throw ConfigError(file, field, "must be a finite number >= 0");
+  };
+  requirePositive(d.recommended_step, file, "recommended_step");
+  nonNegative(d.gravity, "gravity");
+  requirePositive(tr.max_torque, file, "treels.max_torque");
+  requirePositive(tr.torque_unit, file, "treels.torque_unit");
+  requirePositive(tr.speed_unit, file, "treels.speed_unit");
+  requirePositive(tr.speed_limit_units, file, "treels.speed_limit_units");
+  requirePositive(tr.gear_ratio, file, "treels.gear_ratio");
+  for (const auto& r : tr.wheel_radii) requirePositive(r.second, file, "treels.wheel_radii." + r.first);
+  nonNegative(tr.rotor_inertia, "treels.rotor_inertia");
+  nonNegative(tr.backdrive_force, "treels.backdrive_force");
+  nonNegative(tr.torque_window, "treels.torque_window");
   tr.drive = get<std::string>(t, "drive", tr.drive, file, "treels.");
   if (tr.drive != "wheels" && tr.drive != "body")
     throw ConfigError(file, "treels.drive", "expected 'wheels' or 'body', found '" + tr.drive + "'");
   if (tr.left_joints.empty() || tr.right_joints.empty())
     throw ConfigError(file, "treels.left_joints/right_joints", "each track needs at least one driven joint");
-  if (!(tr.wheel_radius > 0)) throw ConfigError(file, "treels.wheel_radius", "must be > 0");
+  requirePositive(tr.wheel_radius, file, "treels.wheel_radius");
   for (const auto& side : {tr.left_joints, tr.right_joints}) {
     for (const auto& name : side) {
       const JointDescription* j = d.findJoint(name);
@@ -175,6 +245,16 @@ void parseSidecar(RobotDescription& d) {
     tt.torque_unit = get<double>(tu, "torque_unit", tt.torque_unit, file, "turret.");
     if (!tt.joint.empty() && !d.findJoint(tt.joint))
       throw ConfigError(file, "turret.joint", "joint '" + tt.joint + "' is not in " + d.urdf_path);
+    for (const auto& side : {tr.left_joints, tr.right_joints})
+      for (const auto& name : side)
+        if (name == tt.joint) throw ConfigError(file, "turret.joint", "'" + name + "' is a driven treels joint");
+    if (!tt.joint.empty()) {
+      requirePositive(tt.speed, file, "turret.speed");
+      requirePositive(tt.unit, file, "turret.unit");
+      requirePositive(tt.range_units, file, "turret.range_units");
+      requirePositive(tt.max_torque, file, "turret.max_torque");
+      requirePositive(tt.torque_unit, file, "turret.torque_unit");
+    }
   }
 
   if (const YAML::Node m = root["materials"]) {
@@ -247,7 +327,7 @@ RobotDescription loadRobotDescription(const std::string& urdf_path, const std::s
   std::vector<urdf::LinkConstSharedPtr> queue{model->getRoot()};
   for (std::size_t i = 0; i < queue.size(); ++i) {
     const auto& link = queue[i];
-    d.links.push_back(convertLink(*link, urdf_path));
+    d.links.push_back(convertLink(*link, d.urdf_xml, urdf_path));
     if (i > 0) d.joints.push_back(convertJoint(*link->parent_joint, urdf_path));
     for (const auto& child : link->child_links) queue.push_back(child);
   }

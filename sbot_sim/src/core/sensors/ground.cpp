@@ -17,7 +17,7 @@ IrRayModel groundRayModel(const RobotDescription& d) {
   m.range_min = extraNumber(d, "ground_range_min_m", 0.001);  // Table 2.9: 0.1 cm
   m.range_max = extraNumber(d, "ground_range_max_m", 0.06);   // Table 2.9: 6 cm
   m.cone_angle = extraNumber(d, "ground_cone_angle_rad", 0.52359878);
-  m.rays = static_cast<int>(extraNumber(d, "ground_rays", 5));
+  m.rays = extraCount(d, "ground_rays", 5, 1, 1000);
   if (m.rays < 1 || !(m.range_max > m.range_min) || !(m.range_min > 0)) {
     throw ConfigError(d.sidecar_path, "extra/ground_*",
                       "need ground_rays >= 1 and 0 < ground_range_min_m < ground_range_max_m");

@@ -30,7 +30,7 @@ IrRayModel proximityRayModel(const RobotDescription& d) {
   m.range_min = extraNumber(d, "ir_range_min_m", m.range_min);
   m.range_max = extraNumber(d, "ir_range_max_m", m.range_max);
   m.cone_angle = extraNumber(d, "ir_cone_angle_rad", m.cone_angle);
-  m.rays = static_cast<int>(extraNumber(d, "ir_rays", m.rays));
+  m.rays = extraCount(d, "ir_rays", m.rays, 1, 1000);
   if (m.rays < 1 || !(m.range_max > m.range_min) || !(m.range_min > 0)) {
     throw ConfigError(d.sidecar_path, "extra/ir_*", "need ir_rays >= 1 and 0 < ir_range_min_m < ir_range_max_m");
   }

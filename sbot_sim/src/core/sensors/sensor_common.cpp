@@ -23,10 +23,20 @@ double extraNumber(const RobotDescription& d, const std::string& key, double fal
     if (used != it->second.size() && it->second.find_first_not_of(" \t", used) != std::string::npos) {
       throw std::invalid_argument("trailing text");
     }
+    if (!std::isfinite(v)) throw std::invalid_argument("not finite");
     return v;
   } catch (const std::exception&) {
-    throw ConfigError(d.sidecar_path, "extra/" + key, "expected a number, got '" + it->second + "'");
+    throw ConfigError(d.sidecar_path, "extra/" + key, "expected a finite number, got '" + it->second + "'");
   }
+}
+
+int extraCount(const RobotDescription& d, const std::string& key, int fallback, int lo, int hi) {
+  const double v = extraNumber(d, key, fallback);
+  if (v != std::floor(v) || v < lo || v > hi)
+    throw ConfigError(d.sidecar_path, "extra/" + key,
+                      "expected a whole number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got '" +
+                          d.extra.at(key) + "'");
+  return static_cast<int>(v);
 }
 
 bool extraBool(const RobotDescription& d, const std::string& key, bool fallback) {

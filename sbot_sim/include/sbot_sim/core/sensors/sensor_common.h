@@ -33,8 +33,10 @@ struct RobotDescription;
 namespace sensors {
 
 /// Sidecar `extra` value `key` as a number; `fallback` if absent. Throws ConfigError naming the
-/// sidecar and key if present but not a number.
+/// sidecar and key if present but not a finite number.
 double extraNumber(const RobotDescription& d, const std::string& key, double fallback);
+/// Sidecar `extra` value `key` as a whole number in [lo, hi] (ray counts); `fallback` if absent.
+int extraCount(const RobotDescription& d, const std::string& key, int fallback, int lo, int hi);
 /// Sidecar `extra` value `key` as a boolean ("true"/"false"/"1"/"0"/"yes"/"no").
 bool extraBool(const RobotDescription& d, const std::string& key, bool fallback);
 

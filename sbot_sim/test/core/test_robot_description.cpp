@@ -1,0 +1,149 @@
+// Loading a level's URDF and sidecar (robot_description.h): the real files load; a copy with one
+// value broken is refused with a ConfigError naming the file and the field, never loaded into a
+// robot that is massless, shapeless or cannot drive (or that ODE aborts on: a negative radius).
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/robot_description.h"
+#include "sbot_sim/core/sensors/sensor_common.h"
+
+namespace sbot {
+namespace {
+
+std::string read(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// The Simple level's two files, copied into a fresh folder so that one value can be broken.
+class BrokenCopy {
+ public:
+  BrokenCopy() {
+    char dir[] = "/tmp/sbot_description_XXXXXX";
+    dir_ = mkdtemp(dir);
+    const std::string src = descriptionDirectory() + "/urdf/simple";
+    urdf_ = read(src + ".urdf");
+    sidecar_ = read(src + ".sbot.yaml");
+  }
+  ~BrokenCopy() {
+    std::remove(urdfPath().c_str());
+    std::remove(sidecarPath().c_str());
+    rmdir(dir_.c_str());
+  }
+  std::string urdfPath() const { return dir_ + "/simple.urdf"; }
+  std::string sidecarPath() const { return dir_ + "/simple.sbot.yaml"; }
+
+  /// Replace the first `from` found after `anchor` in the URDF (or the sidecar).
+  void breakUrdf(const std::string& anchor, const std::string& from, const std::string& to) { replace(urdf_, anchor, from, to); }
+  void breakSidecar(const std::string& from, const std::string& to) { replace(sidecar_, "", from, to); }
+
+  /// The ConfigError's message, or "" if the copy loaded.
+  std::string loadError() const {
+    std::ofstream(urdfPath()) << urdf_;
+    std::ofstream(sidecarPath()) << sidecar_;
+    try {
+      loadRobotDescription(urdfPath(), sidecarPath());
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "";
+  }
+
+ private:
+  static void replace(std::string& text, const std::string& anchor, const std::string& from, const std::string& to) {
+    const std::size_t a = text.find(anchor);
+    ASSERT_NE(a, std::string::npos) << "anchor '" << anchor << "' not in the file";
+    const std::size_t i = text.find(from, a);
+    ASSERT_NE(i, std::string::npos) << "'" << from << "' not in the file after '" << anchor << "'";
+    text.replace(i, from.size(), to);
+  }
+  std::string dir_, urdf_, sidecar_;
+};
+
+TEST(RobotDescription, TheUnbrokenCopyLoads) { EXPECT_EQ(BrokenCopy().loadError(), ""); }
+
+TEST(RobotDescription, ShapesMustHaveAPositiveSize) {
+  for (const std::string radius : {"-0.01", "0"}) {
+    BrokenCopy c;
+    c.breakUrdf("<collision>", "<sphere radius=\"0.018\"/>", "<sphere radius=\"" + radius + "\"/>");
+    EXPECT_NE(c.loadError().find("simple.urdf: field 'link base_link/collision/geometry/sphere radius': must be a finite number > 0"),
+              std::string::npos)
+        << radius << ": " << c.loadError();
+  }
+}
+
+// urdfdom drops an element it cannot parse (only a message on stderr): the chassis lost its
+// collision sphere and its mass.
+TEST(RobotDescription, AnElementUrdfdomDroppedIsAnError) {
+  BrokenCopy shape;
+  shape.breakUrdf("<collision>", "<sphere radius=\"0.018\"/>", "<sphere radius=\"nan\"/>");
+  EXPECT_NE(shape.loadError().find("field 'link base_link': urdfdom could not parse all of it"), std::string::npos)
+      << shape.loadError();
+  BrokenCopy mass;
+  mass.breakUrdf("<link name=\"base_link\">", "<mass value=\"0.25\"/>", "<mass value=\"heavy\"/>");
+  EXPECT_NE(mass.loadError().find("field 'link base_link': urdfdom could not parse all of it"), std::string::npos)
+      << mass.loadError();
+}
+
+TEST(RobotDescription, MotorNumbersMustBeFiniteAndPositive) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"  max_torque: 0.21971", "treels.max_torque"},
+      {"  speed_unit: 0.0028", "treels.speed_unit"},
+      {"  gear_ratio: 150", "treels.gear_ratio"},
+      {"  wheel_radius: 0.022", "treels.wheel_radius"},
+      {"recommended_step: 0.01", "recommended_step"},
+  };
+  for (const auto& [line, field] : cases) {
+    for (const std::string bad : {".nan", "0", "-1"}) {
+      BrokenCopy c;
+      c.breakSidecar(line, line.substr(0, line.find(':') + 2) + bad);
+      EXPECT_NE(c.loadError().find("simple.sbot.yaml: field '" + field + "': must be a finite number > 0"), std::string::npos)
+          << line << " -> " << bad << ": " << c.loadError();
+    }
+  }
+  BrokenCopy turret;
+  turret.breakSidecar("max_torque: 1.4881352", "max_torque: .nan");
+  EXPECT_NE(turret.loadError().find("field 'turret.max_torque'"), std::string::npos) << turret.loadError();
+  BrokenCopy gravity;
+  gravity.breakSidecar("gravity: 9.81", "gravity: -9.81");
+  EXPECT_NE(gravity.loadError().find("field 'gravity': must be a finite number >= 0"), std::string::npos) << gravity.loadError();
+}
+
+TEST(RobotDescription, TheTurretCannotBeADrivenWheel) {
+  BrokenCopy c;
+  c.breakSidecar("turret: {joint: turret_joint", "turret: {joint: left_wheel_joint");
+  EXPECT_NE(c.loadError().find("field 'turret.joint': 'left_wheel_joint' is a driven treels joint"), std::string::npos)
+      << c.loadError();
+}
+
+// Sensor parameters in the sidecar's `extra` (kept as text, read by the sensor models).
+TEST(RobotDescription, SensorExtrasMustBeFiniteAndRayCountsWhole) {
+  RobotDescription d;
+  d.sidecar_path = "x.sbot.yaml";
+  EXPECT_EQ(sensors::extraCount(d, "ir_rays", 5, 1, 1000), 5) << "absent: the fallback";
+  d.extra["ir_rays"] = "7";
+  EXPECT_EQ(sensors::extraCount(d, "ir_rays", 5, 1, 1000), 7);
+  for (const std::string bad : {"-3", "0", "2.5", "1e9"}) {
+    d.extra["ir_rays"] = bad;
+    try {
+      sensors::extraCount(d, "ir_rays", 5, 1, 1000);
+      ADD_FAILURE() << "ir_rays " << bad << " accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("x.sbot.yaml: field 'extra/ir_rays': expected a whole number in [1, 1000]"),
+                std::string::npos) << e.what();
+    }
+  }
+  d.extra["ir_noise"] = "nan";
+  EXPECT_THROW(sensors::extraNumber(d, "ir_noise", 0.1), ConfigError);
+}
+
+}  // namespace
+}  // namespace sbot
