@@ -149,7 +149,6 @@ def main(argv=None):
     if a.run_name and len(a.bags) > 1:
         raise SystemExit("--run-name needs a single bag")
 
-    os.makedirs(a.out, exist_ok=True)
     yaml_path = os.path.join(a.out, "dataset.yaml")
     if a.append and os.path.exists(yaml_path):
         with open(yaml_path) as f:
@@ -162,16 +161,25 @@ def main(argv=None):
         with open(a.world) as f:
             w = yaml.safe_load(f)
         ds["world"] = w.get("world", w)
-    names = {r["name"] for r in ds["runs"]}
+    # Read every bag before writing anything: an unreadable bag stops the import with its name and
+    # leaves the output directory as it was (no CSV without its dataset.yaml entry).
+    imported = []
     for bag in a.bags:
+        try:
+            rows, pose, missing = read_run(bag, topics)
+        except Exception as error:  # rosbag raises several unrelated types for unreadable files
+            raise SystemExit("bag_to_dataset: cannot read %s: %s" % (bag, error))
+        if not rows:
+            raise SystemExit("%s: none of the topics %s is in the bag" % (bag, sorted(t for t in topics.values() if t)))
+        imported.append((bag, rows, pose, missing))
+    os.makedirs(a.out, exist_ok=True)
+    names = {r["name"] for r in ds["runs"]}
+    for bag, rows, pose, missing in imported:
         name = a.run_name or os.path.splitext(os.path.basename(bag))[0]
         base, k = name, 2
         while name in names:
             name = "%s_%d" % (base, k)
             k += 1
-        rows, pose, missing = read_run(bag, topics)
-        if not rows:
-            raise SystemExit("%s: none of the topics %s is in the bag" % (bag, sorted(t for t in topics.values() if t)))
         cols = write_csv(os.path.join(a.out, name + ".csv"), rows)
         run = {"name": name, "file": name + ".csv", "kind": "drive",
                "initial_pose": {"x": pose[0], "y": pose[1], "yaw": pose[2]} if pose else {"x": 0.0, "y": 0.0, "yaw": 0.0}}

@@ -128,6 +128,18 @@ class BagImporterTest(unittest.TestCase):
             bag_to_dataset.main([os.path.join(self.tmp, "bad"), path, "--tracker-topic", "/tracker/sbot_0"])
         self.assertIn("command", str(e.exception))
 
+    def test_unreadable_bag_is_named_and_nothing_is_written(self):
+        good = os.path.join(self.tmp, "good.bag")
+        self.write_bag("straight_20", good)
+        corrupt = os.path.join(self.tmp, "corrupt.bag")
+        with open(corrupt, "wb") as f:
+            f.write(b"#ROSBAG V2.0\n" + bytes(range(256)) * 8)
+        out = os.path.join(self.tmp, "partial")
+        with self.assertRaises(SystemExit) as e:
+            bag_to_dataset.main([out, good, corrupt, "--tracker-topic", "/tracker/sbot_0"])
+        self.assertIn("cannot read %s" % corrupt, str(e.exception))
+        self.assertFalse(os.path.exists(out), "the good bag's CSV was written without a dataset.yaml")
+
 
 if __name__ == "__main__":
     unittest.main(argv=sys.argv[:1])
