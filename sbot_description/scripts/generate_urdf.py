@@ -255,6 +255,17 @@ EXTRA_FLAGS = ("ir_model", "ground_sensors", "camera", "sound_model", "light_rin
                "side_arm", "treels_model")
 
 
+def turret_sensor_ring(rb, prefix, ring, radius):
+    """Frames <prefix>_0.. of a ring of sensors on the turret (IR, light, microphones all sit this way):
+    `ring` count, first_rad, step_rad, z_m; each at `radius`, +x pointing outwards."""
+    for i in range(ring["count"]):
+        a = ring["first_rad"] + i * ring["step_rad"]
+        a = math.atan2(math.sin(a), math.cos(a))
+        rb.link("%s_%d" % (prefix, i))
+        rb.joint("%s_%d_joint" % (prefix, i), "fixed", "turret", "%s_%d" % (prefix, i),
+                 (radius * math.cos(a), radius * math.sin(a), ring["z_m"]), (0, 0, a))
+
+
 def build(level, p):
     """Return (Robot, sidecar dict) for one resolved level."""
     rb = Robot("sbot_" + level)
@@ -381,39 +392,18 @@ def build(level, p):
 
     # ---- sensor frames (massless, fixed, +x = sensing direction) -----------------------------
     s = p["sensors"]
-    ir = s["ir"]
-    for i in range(ir["count"]):
-        a = ir["first_rad"] + i * ir["step_rad"]
-        a = math.atan2(math.sin(a), math.cos(a))
-        r = s["ir_radius_m"]
-        rb.link("ir_%d" % i)
-        rb.joint("ir_%d_joint" % i, "fixed", "turret", "ir_%d" % i,
-                 (r * math.cos(a), r * math.sin(a), ir["z_m"]), (0, 0, a))
+    turret_sensor_ring(rb, "ir", s["ir"], s["ir_radius_m"])
     gr = s["ground"]
     for i, (x, y) in enumerate(((gr["x_m"], 0), (0, gr["y_m"]), (-gr["x_m"], 0), (0, -gr["y_m"]))):
         rb.link("ground_%d" % i)
         rb.joint("ground_%d_joint" % i, "fixed", "base_link", "ground_%d" % i, (x, y, gr["z_m"]),
                  (0, HALF_PI, 0))
-    li = s["light"]
-    for i in range(li["count"]):
-        a = li["first_rad"] + i * li["step_rad"]
-        a = math.atan2(math.sin(a), math.cos(a))
-        r = s["light_radius_m"]
-        rb.link("light_%d" % i)
-        rb.joint("light_%d_joint" % i, "fixed", "turret", "light_%d" % i,
-                 (r * math.cos(a), r * math.sin(a), li["z_m"]), (0, 0, a))
+    turret_sensor_ring(rb, "light", s["light"], s["light_radius_m"])
     rb.link("camera")
     rb.joint("camera_joint", "fixed", "turret", "camera", (0, 0, s["camera_z_m"]), (0, HALF_PI, 0))
     rb.link("fake_camera")
     rb.joint("fake_camera_joint", "fixed", "turret", "fake_camera", (0, 0, s["fake_camera_z_m"]))
-    mi = s["mic"]
-    for i in range(mi["count"]):
-        a = mi["first_rad"] + i * mi["step_rad"]
-        a = math.atan2(math.sin(a), math.cos(a))
-        r = mi["radius_m"]
-        rb.link("mic_%d" % i)
-        rb.joint("mic_%d_joint" % i, "fixed", "turret", "mic_%d" % i,
-                 (r * math.cos(a), r * math.sin(a), mi["z_m"]), (0, 0, a))
+    turret_sensor_ring(rb, "mic", s["mic"], s["mic"]["radius_m"])
 
     # ---- side arm -----------------------------------------------------------------------------
     side_arm_side = None
