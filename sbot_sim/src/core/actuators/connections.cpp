@@ -88,6 +88,11 @@ const Connection* ConnectionManager::find(const std::string& holder, Connection:
   return nullptr;
 }
 
+std::string ConnectionManager::heldBy(const std::string& holder, Connection::Kind kind) const {
+  const Connection* c = find(holder, kind);
+  return c ? c->held : std::string();
+}
+
 double ConnectionManager::force(const Connection& c) const {
   if (!c.feedback) return 0;
   const dReal* f = c.feedback->f1;

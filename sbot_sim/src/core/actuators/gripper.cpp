@@ -224,8 +224,7 @@ bool FrontGripper::gripping() const {
 }
 
 std::string FrontGripper::gripped() const {
-  const Connection* c = world_.connections().find(robot_.name(), Connection::FrontGripper);
-  return c ? c->held : std::string();
+  return world_.connections().heldBy(robot_.name(), Connection::FrontGripper);
 }
 
 }  // namespace actuators

@@ -199,8 +199,7 @@ bool SideArm::gripping() const {
 }
 
 std::string SideArm::gripped() const {
-  const Connection* c = world_.connections().find(robot_.name(), Connection::SideArm);
-  return c ? c->held : std::string();
+  return world_.connections().heldBy(robot_.name(), Connection::SideArm);
 }
 
 }  // namespace actuators

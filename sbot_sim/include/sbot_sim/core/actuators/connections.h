@@ -57,6 +57,8 @@ class ConnectionManager {
   std::vector<Connection> of(const std::string& robot) const;
   /// The connection `holder` makes with `kind`, or nullptr.
   const Connection* find(const std::string& holder, Connection::Kind kind) const;
+  /// The robot `holder` holds with `kind`, or "" (what FrontGripper::gripped and SideArm::gripped report).
+  std::string heldBy(const std::string& holder, Connection::Kind kind) const;
   /// Force [N] transmitted by a connection last step (|f1|), 0 if unknown.
   double force(const Connection& c) const;
 
