@@ -311,6 +311,10 @@ std::string RobotDescription::extraOr(const std::string& key, const std::string&
   return it == extra.end() ? fallback : it->second;
 }
 
+double sidecarNumber(const YAML::Node& entry, const char* key, double fallback) {
+  return entry && entry[key] ? entry[key].as<double>() : fallback;
+}
+
 RobotDescription loadRobotDescription(const std::string& urdf_path, const std::string& sidecar_path) {
   RobotDescription d;
   d.urdf_path = urdf_path;

@@ -18,10 +18,6 @@ constexpr double kJawProbeRadius = 0.015;  ///< [m] the jaws reach around the ri
 constexpr double kStallRate = 0.05;     ///< [rad/s] jaws considered stopped below
 constexpr double kStallTime = 0.1;      ///< [s]
 
-double num(const YAML::Node& n, const char* key, double fallback) {
-  return n && n[key] ? n[key].as<double>() : fallback;
-}
-
 struct ProbeData {
   const Robot* self;
   dGeomID probe;
@@ -60,12 +56,12 @@ FrontGripper::FrontGripper(World& world, Robot& robot) : world_(world), robot_(r
   if (g && g["link"]) link_ = g["link"].as<std::string>();
   if (g && g["tip_frame"]) tip_ = g["tip_frame"].as<std::string>();
   if (g && g["elevation_joint"]) elevation_joint_ = g["elevation_joint"].as<std::string>();
-  elevation_torque_ = num(g, "elevation_torque", elevation_torque_);
-  elevation_speed_ = num(g, "elevation_speed", elevation_speed_);
-  elevation_lower_ = num(g, "elevation_lower", elevation_lower_);
-  elevation_upper_ = num(g, "elevation_upper", elevation_upper_);
-  jaw_speed_ = num(g, "jaw_speed", jaw_speed_);
-  jaw_torque_ = num(g, "jaw_torque", jaw_torque_);
+  elevation_torque_ = sidecarNumber(g, "elevation_torque", elevation_torque_);
+  elevation_speed_ = sidecarNumber(g, "elevation_speed", elevation_speed_);
+  elevation_lower_ = sidecarNumber(g, "elevation_lower", elevation_lower_);
+  elevation_upper_ = sidecarNumber(g, "elevation_upper", elevation_upper_);
+  jaw_speed_ = sidecarNumber(g, "jaw_speed", jaw_speed_);
+  jaw_torque_ = sidecarNumber(g, "jaw_torque", jaw_torque_);
   if (g && g["jaw_joints"] && g["jaw_joints"].size() == 2) {
     jaw_upper_ = g["jaw_joints"][0].as<std::string>();
     jaw_lower_ = g["jaw_joints"][1].as<std::string>();

@@ -16,9 +16,6 @@ constexpr double kBreakMargin = 5.0;
 constexpr double kForceFilter = 0.1;  ///< [s]
 constexpr double kProbeRadius = 0.012;  ///< [m] around the grip point between the jaws
 
-double num(const YAML::Node& n, const char* key, double fallback) {
-  return n && n[key] ? n[key].as<double>() : fallback;
-}
 }  // namespace
 
 SideArm::SideArm(World& world, Robot& robot) : world_(world), robot_(robot) {
@@ -32,20 +29,20 @@ SideArm::SideArm(World& world, Robot& robot) : world_(world), robot_(robot) {
   j_jaw_a_ = str("jaw_a");
   j_jaw_b_ = str("jaw_b");
   tip_link_ = a["tip_link"] ? a["tip_link"].as<std::string>() : "side_arm_tip_a";
-  unit_ = num(a, "unit", unit_);
-  s_ = num(a, "link_length", s_);
-  rhombi_ = static_cast<int>(num(a, "rhombi", rhombi_));
-  a0_ = num(a, "rest_half_angle", a0_);
-  a_min_ = num(a, "half_angle_min", a_min_);
-  a_max_ = num(a, "half_angle_max", a_max_);
-  rotation_range_ = num(a, "rotation_range", rotation_range_);
-  elevation_torque_ = num(a, "elevation_torque", elevation_torque_);
-  horizontal_torque_ = num(a, "horizontal_torque", horizontal_torque_);
-  servo_speed_ = num(a, "servo_speed", servo_speed_);
-  jaw_force_ = num(a, "jaw_force", jaw_force_);
-  jaw_torque_ = num(a, "jaw_torque", jaw_torque_);
-  jaw_speed_ = num(a, "jaw_speed", jaw_speed_);
-  aperture_max_ = num(a, "aperture_max", aperture_max_);
+  unit_ = sidecarNumber(a, "unit", unit_);
+  s_ = sidecarNumber(a, "link_length", s_);
+  rhombi_ = static_cast<int>(sidecarNumber(a, "rhombi", rhombi_));
+  a0_ = sidecarNumber(a, "rest_half_angle", a0_);
+  a_min_ = sidecarNumber(a, "half_angle_min", a_min_);
+  a_max_ = sidecarNumber(a, "half_angle_max", a_max_);
+  rotation_range_ = sidecarNumber(a, "rotation_range", rotation_range_);
+  elevation_torque_ = sidecarNumber(a, "elevation_torque", elevation_torque_);
+  horizontal_torque_ = sidecarNumber(a, "horizontal_torque", horizontal_torque_);
+  servo_speed_ = sidecarNumber(a, "servo_speed", servo_speed_);
+  jaw_force_ = sidecarNumber(a, "jaw_force", jaw_force_);
+  jaw_torque_ = sidecarNumber(a, "jaw_torque", jaw_torque_);
+  jaw_speed_ = sidecarNumber(a, "jaw_speed", jaw_speed_);
+  aperture_max_ = sidecarNumber(a, "aperture_max", aperture_max_);
   if (const JointDescription* j = robot.description().findJoint(j_elev_)) elev_range_ = std::min(-j->lower, j->upper);
   available_ = robot.hingeJoint(j_elev_) && robot.hingeJoint(j_left_) && robot.hingeJoint(j_right_);
   if (available_ && a["loop_joints"]) closeLoops(a["loop_joints"]);
