@@ -140,6 +140,14 @@ BarrierReading FrontGripper::getOpticalBarrier() const {
   return r;
 }
 
+void driveHinge(const Robot& robot, const std::string& joint, double target, double speed, double fmax) {
+  dJointID j = robot.hingeJoint(joint);
+  if (!j) return;
+  const double err = target - robot.jointAngle(joint);
+  dJointSetHingeParam(j, dParamVel, std::clamp(kServoGain * err, -speed, speed));
+  dJointSetHingeParam(j, dParamFMax, fmax);
+}
+
 bool probeStickable(World& world, const Robot& self, const Vec3& p, double radius, std::string* who, dBodyID* body) {
   dGeomID probe = dCreateSphere(nullptr, radius);
   dGeomSetPosition(probe, p.x(), p.y(), p.z());
@@ -176,12 +184,8 @@ void FrontGripper::update(double dt) {
     return;
   }
   // Elevation servo.
-  if (dJointID j = robot_.hingeJoint(elevation_joint_)) {
-    const double target = std::clamp(cmd_elevation_ * kDeg, elevation_lower_, elevation_upper_);
-    const double err = target - robot_.jointAngle(elevation_joint_);
-    dJointSetHingeParam(j, dParamVel, std::clamp(kServoGain * err, -elevation_speed_, elevation_speed_));
-    dJointSetHingeParam(j, dParamFMax, elevation_torque_);
-  }
+  driveHinge(robot_, elevation_joint_, std::clamp(cmd_elevation_ * kDeg, elevation_lower_, elevation_upper_),
+             elevation_speed_, elevation_torque_);
   if (type_ == Type::Sticky) {
     if (closing_ && !gripping()) tryConnect();
     closing_ = false;
@@ -192,11 +196,8 @@ void FrontGripper::update(double dt) {
   jaws_holding_ = jaws_holding_ && gripping();
   double moving = 0;
   for (const std::string& jn : {jaw_upper_, jaw_lower_}) {
-    dJointID j = robot_.hingeJoint(jn);
     const double target = !jaws_holding_ ? half : jn == jaw_upper_ ? jaw_hold_upper_ : jaw_hold_lower_;
-    const double err = target - robot_.jointAngle(jn);
-    dJointSetHingeParam(j, dParamVel, std::clamp(kServoGain * err, -jaw_speed_, jaw_speed_));
-    dJointSetHingeParam(j, dParamFMax, jaw_torque_);
+    driveHinge(robot_, jn, target, jaw_speed_, jaw_torque_);
     moving = std::max(moving, std::abs(robot_.jointRate(jn)));
   }
   if (closing_) {

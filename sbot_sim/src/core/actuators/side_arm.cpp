@@ -9,7 +9,6 @@ namespace sbot {
 namespace actuators {
 
 namespace {
-constexpr double kServoGain = 10.0;
 constexpr double kStallRate = 0.05;
 constexpr double kStallTime = 0.1;
 constexpr double kBreakMargin = 5.0;
@@ -149,22 +148,14 @@ BarrierReading SideArm::getOpticalBarrier() const {
   return r;
 }
 
-void SideArm::drive(const std::string& joint, double target, double speed, double fmax) {
-  dJointID j = robot_.hingeJoint(joint);
-  if (!j) return;
-  const double err = target - robot_.jointAngle(joint);
-  dJointSetHingeParam(j, dParamVel, std::clamp(kServoGain * err, -speed, speed));
-  dJointSetHingeParam(j, dParamFMax, fmax);
-}
-
 void SideArm::update(double dt) {
   if (!available_) return;
-  drive(j_elev_, t_qe_, servo_speed_, elevation_torque_);
-  drive(j_left_, t_ql_, servo_speed_, horizontal_torque_);
-  drive(j_right_, t_qr_, servo_speed_, horizontal_torque_);
+  driveHinge(robot_, j_elev_, t_qe_, servo_speed_, elevation_torque_);
+  driveHinge(robot_, j_left_, t_ql_, servo_speed_, horizontal_torque_);
+  driveHinge(robot_, j_right_, t_qr_, servo_speed_, horizontal_torque_);
   const double jaw = closed_cmd_ ? 0.0 : aperture_max_;
-  drive(j_jaw_a_, jaw, jaw_speed_, jaw_torque_);
-  drive(j_jaw_b_, jaw, jaw_speed_, jaw_torque_);
+  driveHinge(robot_, j_jaw_a_, jaw, jaw_speed_, jaw_torque_);
+  driveHinge(robot_, j_jaw_b_, jaw, jaw_speed_, jaw_torque_);
   if (closing_) {
     const double moving = std::max(std::abs(robot_.jointRate(j_jaw_a_)), std::abs(robot_.jointRate(j_jaw_b_)));
     const bool reached = robot_.jointAngle(j_jaw_a_) < 0.02 && robot_.jointAngle(j_jaw_b_) < 0.02;

@@ -59,6 +59,11 @@ unsigned barrierValue(bool hit, double distance, double lo, double hi);
 bool probeStickable(World& world, const Robot& self, const Vec3& point, double radius, std::string* who,
                     dBodyID* body);
 
+/// The position servo every gripper motor runs (front gripper elevation and jaws, side arm): the hinge
+/// `joint` of `robot` is driven toward `target` [rad] at 10 rad/s per rad of error, at most `speed`
+/// [rad/s], with at most `fmax` [N m]. Does nothing when the robot has no such hinge.
+void driveHinge(const Robot& robot, const std::string& joint, double target, double speed, double fmax);
+
 class FrontGripper {
  public:
   enum class Type { None, Sticky, Jaws };

@@ -71,7 +71,6 @@ class SideArm {
   void forward(double qe, double ql, double qr, double* elevation, double* rotation, double* depth) const;
 
  private:
-  void drive(const std::string& joint, double target, double speed, double fmax);
   void closeLoops(const YAML::Node& loops);
   std::vector<dJointID> loop_joints_;  ///< the sidecar's loop closures (URDF is a tree), owned here
   World& world_;
