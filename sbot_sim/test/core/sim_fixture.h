@@ -20,6 +20,13 @@ inline void runFor(World& w, double seconds) {
   w.stepN(n);
 }
 
+/// The pose of `link` of a robot of `level` freshly spawned at `at` on the flat floor (spawning is
+/// deterministic): where the sensor tests place walls, pads and lamps relative to a sensor.
+inline Pose spawnPose(const std::string& level, const Pose2D& at, const std::string& link) {
+  World w(flatWorld());
+  return w.addRobot(loadLevel(level), at, "probe").linkPose(link);
+}
+
 /// Yaw difference wrapped to (-pi, pi].
 inline double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 

@@ -14,11 +14,6 @@ namespace {
 
 using namespace sbot::sensors;
 
-Pose spawnPose(const std::string& level, const Pose2D& at, const std::string& link) {
-  World w(flatWorld());
-  return w.addRobot(loadLevel(level), at, "probe").linkPose(link);
-}
-
 // A 1.5 x 1.5 cm pad standing on the floor whose top is `gap` below ground sensor `link`.
 BoxObstacle padUnder(const Pose& sensor, double gap) {
   BoxObstacle b;

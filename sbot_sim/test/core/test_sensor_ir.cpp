@@ -15,13 +15,6 @@ namespace {
 
 using namespace sbot::sensors;
 
-// The pose of `link` of a robot of `level` freshly spawned at `at` on the flat floor (spawning is
-// deterministic).
-Pose spawnPose(const std::string& level, const Pose2D& at, const std::string& link) {
-  World w(flatWorld());
-  return w.addRobot(loadLevel(level), at, "probe").linkPose(link);
-}
-
 // Spawn a robot exactly where it would rest on the flat floor, even if a box is close (addRobot
 // would lift it onto any box within its bounding box).
 Robot& spawnOnFloor(World& w, const std::string& level, const Pose2D& at, const std::string& name) {

@@ -16,11 +16,6 @@ using namespace sbot::sensors;
 
 constexpr double kUnit = 0.1685;  // Table 2.10 [mcd/cm^2]
 
-Pose spawnPose(const std::string& level, const Pose2D& at, const std::string& link) {
-  World w(flatWorld());
-  return w.addRobot(loadLevel(level), at, "probe").linkPose(link);
-}
-
 // Expected noise-free, unshadowed reading of `sensor` for a lamp (no ambient).
 double expectedReading(const Pose& sensor, const Vec3& lamp, double intensity) {
   const Vec3 v = lamp - sensor.position;
