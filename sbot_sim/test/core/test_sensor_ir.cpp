@@ -21,11 +21,18 @@ Robot& spawnOnFloor(World& w, const std::string& level, const Pose2D& at, const 
   return w.addRobotAt(loadLevel(level), spawnPose(level, at, "base_link"), name);
 }
 
-// A 2 cm thick wall whose near face is `distance` in front of `sensor`, facing it.
-BoxObstacle wallFacing(const Pose& sensor, double distance, const std::string& surface = "white_paper") {
+// The sensor's axis (+x) projected on the floor, unit length: the direction walls and neighbours are
+// placed along.
+Vec3 floorAxis(const Pose& sensor) {
   Vec3 axis = sensor.orientation * Vec3::UnitX();
   axis.z() = 0;
   axis.normalize();
+  return axis;
+}
+
+// A 2 cm thick wall whose near face is `distance` in front of `sensor`, facing it.
+BoxObstacle wallFacing(const Pose& sensor, double distance, const std::string& surface = "white_paper") {
+  const Vec3 axis = floorAxis(sensor);
   BoxObstacle b;
   b.name = "wall";
   b.size = Vec3(0.02, 0.40, 0.30);
@@ -213,9 +220,7 @@ TEST(RayTracedIr, NoiseComesFromTheRobotsSeededStream) {
 TEST(LutIr, SeesANeighbourLikeTheRayTracedModelButNoWalls) {
   const Pose2D at{0, 0, 0.5};
   const Pose sensor = spawnPose("simple", at, "ir_2");
-  Vec3 axis = sensor.orientation * Vec3::UnitX();
-  axis.z() = 0;
-  axis.normalize();
+  const Vec3 axis = floorAxis(sensor);
   const double radius = turretRadius(loadLevel("simple"));
   for (double gap : {0.008, 0.03, 0.08}) {
     World w(flatWorld(11));
@@ -255,9 +260,7 @@ TEST(LutIr, FastNeighboursAreLookedUpAtTheirOwnSurfaceGap) {
   // 3 cm away (gap measured to its own, smaller turret).
   const Pose2D at{0, 0, 0};
   const Pose sensor = spawnPose("fast", at, "ir_0");
-  Vec3 axis = sensor.orientation * Vec3::UnitX();
-  axis.z() = 0;
-  axis.normalize();
+  const Vec3 axis = floorAxis(sensor);
   const double radius = turretRadius(loadLevel("fast"));
   EXPECT_NEAR(radius, 0.0285, 1e-6);
   WorldConfig cfg = flatWorld();
