@@ -22,6 +22,16 @@ void run(World& w, std::vector<FrontGripper*> grippers, double seconds) {
   }
 }
 
+// The load the connection tests put on a gripped robot: `held` is pushed along +x with 15 N for 100
+// steps while the gripper keeps updating.
+void pushHeld(World& w, FrontGripper& g, Robot& held) {
+  for (int i = 0; i < 100; ++i) {
+    dBodyAddForce(held.baseBody(), 15.0, 0, 0);
+    w.step();
+    g.update(w.config().step);
+  }
+}
+
 TEST(ActuatorGripper, FastAcceptsCommandsWithoutPhysics) {
   World w(flatWorld());
   Robot& r = w.addRobot(loadLevel("fast"), {0, 0, 0}, "sbot_0");
@@ -170,11 +180,7 @@ TEST(ActuatorGripper, JawsConnectToTheRingAfterClosing) {
   }
   EXPECT_LE(widest, 10) << "the jaws hold on the ring";
   const double d0 = (b.basePose().position - a.basePose().position).norm();
-  for (int i = 0; i < 100; ++i) {
-    dBodyAddForce(b.baseBody(), 15.0, 0, 0);
-    w.step();
-    ga.update(w.config().step);
-  }
+  pushHeld(w, ga, b);
   EXPECT_TRUE(ga.gripping());
   EXPECT_LT((b.basePose().position - a.basePose().position).norm(), d0 + 0.05);
   ga.setAperture(20);
@@ -191,11 +197,7 @@ TEST(ActuatorGripper, FixedConnectionHoldsFifteenNewtons) {
   run(w, {&ga}, 0.02);
   ASSERT_TRUE(ga.gripping());
   const double d0 = (b.basePose().position - a.basePose().position).norm();
-  for (int i = 0; i < 100; ++i) {
-    dBodyAddForce(b.baseBody(), 15.0, 0, 0);
-    w.step();
-    ga.update(w.config().step);
-  }
+  pushHeld(w, ga, b);
   EXPECT_TRUE(ga.gripping());
   // A free s-bot pushed with 15 N for 1 s travels metres; held, it stays within the play of the
   // holder's elevation and turret servos (0.5 N m and 1.49 N m, backdrivable).
