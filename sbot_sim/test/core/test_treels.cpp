@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "sbot_sim/core/errors.h"
@@ -13,14 +14,20 @@
 namespace sbot::test {
 namespace {
 
+// The steady-speed measurement of every level (the Fast level must match the others): setSpeed(50, 50),
+// 2 s of acceleration phase and settling, then the base position before and after 3 s more.
+std::pair<Vec3, Vec3> steadyStretchAt50(World& w, Robot& r) {
+  r.setSpeed(50, 50);
+  runFor(w, 2.0);
+  const Vec3 p0 = r.basePose().position;
+  runFor(w, 3.0);
+  return {p0, r.basePose().position};
+}
+
 TEST(Treels, Speed50Gives14cmPerSecond) {
   World w(flatWorld());
   Robot& r = w.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_0");
-  r.setSpeed(50, 50);
-  runFor(w, 2.0);  // acceleration phase and settling
-  const Vec3 p0 = r.basePose().position;
-  runFor(w, 3.0);
-  const Vec3 p1 = r.basePose().position;
+  const auto [p0, p1] = steadyStretchAt50(w, r);
   const double speed = (p1 - p0).head<2>().norm() / 3.0;
   EXPECT_NEAR(speed, 0.140, 0.140 * 0.05) << "steady speed at setSpeed(50,50) [m/s]";
   // It drove forward (+x at yaw 0), not sideways.
@@ -368,11 +375,7 @@ TEST(TreelsFast, SameSteadySpeedAsTheOtherLevels) {
   ASSERT_EQ(loadLevel("fast").treels.drive, "body");
   World w(fastWorld());
   Robot& r = w.addRobot(loadLevel("fast"), {0, 0, 0}, "sbot_0");
-  r.setSpeed(50, 50);
-  runFor(w, 2.0);
-  const Vec3 p0 = r.basePose().position;
-  runFor(w, 3.0);
-  const Vec3 p1 = r.basePose().position;
+  const auto [p0, p1] = steadyStretchAt50(w, r);
   EXPECT_NEAR((p1 - p0).head<2>().norm() / 3.0, 0.140, 0.140 * 0.03) << "seed 2.1.3: the same steady speed";
   EXPECT_GT(p1.x() - p0.x(), 0.99 * (p1 - p0).head<2>().norm()) << "straight ahead";
   EXPECT_GT((r.basePose().orientation * Vec3::UnitZ()).z(), 0.99) << "upright";
