@@ -1,106 +1,76 @@
 // save()/load() of the workbench's result types, for worker processes (parallel.h, serialize.h).
+//
+// A record's save() and load() must write and read the same members in the same order. So each record
+// names that order once, as a tuple of member pointers (k...Members), and both directions walk it
+// (saveMembers/loadMembers): adding a member in one place keeps the two sides in step.
 #pragma once
+
+#include <tuple>
 
 #include "calibration/evaluation.h"
 #include "calibration/fit.h"
 #include "calibration/serialize.h"
 #include "sbot_sim/core/effects/effect_registry.h"
 
+namespace sbot::calib {
+
+template <class Record, class Members>
+void saveMembers(Writer& w, const Record& x, const Members& members) {
+  std::apply([&](auto... m) { (save(w, x.*m), ...); }, members);
+}
+template <class Record, class Members>
+void loadMembers(Reader& r, Record& x, const Members& members) {
+  std::apply([&](auto... m) { (load(r, x.*m), ...); }, members);
+}
+
+}  // namespace sbot::calib
+
 namespace sbot {
 
-inline void save(calib::Writer& w, const Pose2D& p) {
-  w.raw(p.x);
-  w.raw(p.y);
-  w.raw(p.yaw);
-}
-inline void load(calib::Reader& r, Pose2D& p) {
-  r.raw(p.x);
-  r.raw(p.y);
-  r.raw(p.yaw);
-}
-inline void save(calib::Writer& w, const EffectConfig& c) {
-  calib::save(w, c.name);
-  calib::save(w, c.params);
-  calib::save(w, c.stderr_);
-  calib::save(w, c.note);
-}
-inline void load(calib::Reader& r, EffectConfig& c) {
-  calib::load(r, c.name);
-  calib::load(r, c.params);
-  calib::load(r, c.stderr_);
-  calib::load(r, c.note);
-}
+inline constexpr auto kPose2DMembers = std::make_tuple(&Pose2D::x, &Pose2D::y, &Pose2D::yaw);
+inline void save(calib::Writer& w, const Pose2D& p) { calib::saveMembers(w, p, kPose2DMembers); }
+inline void load(calib::Reader& r, Pose2D& p) { calib::loadMembers(r, p, kPose2DMembers); }
+
+inline constexpr auto kEffectConfigMembers =
+    std::make_tuple(&EffectConfig::name, &EffectConfig::params, &EffectConfig::stderr_, &EffectConfig::note);
+inline void save(calib::Writer& w, const EffectConfig& c) { calib::saveMembers(w, c, kEffectConfigMembers); }
+inline void load(calib::Reader& r, EffectConfig& c) { calib::loadMembers(r, c, kEffectConfigMembers); }
 
 }  // namespace sbot
 
 namespace sbot::calib {
 
-inline void save(Writer& w, const ModelSpec& m) {
-  save(w, m.level);
-  save(w, m.effects);
-}
-inline void load(Reader& r, ModelSpec& m) {
-  load(r, m.level);
-  load(r, m.effects);
-}
+inline constexpr auto kModelSpecMembers = std::make_tuple(&ModelSpec::level, &ModelSpec::effects);
+inline void save(Writer& w, const ModelSpec& m) { saveMembers(w, m, kModelSpecMembers); }
+inline void load(Reader& r, ModelSpec& m) { loadMembers(r, m, kModelSpecMembers); }
 
-inline void save(Writer& w, const Trace& t) {
-  for (const auto* v : {&t.t, &t.x, &t.y, &t.yaw, &t.v, &t.w, &t.accel, &t.speed_left, &t.speed_right, &t.torque_left,
-                        &t.torque_right, &t.pitch, &t.roll, &t.cmd_left, &t.cmd_right})
-    save(w, *v);
-  save(w, t.contact);
-}
-inline void load(Reader& r, Trace& t) {
-  for (auto* v : {&t.t, &t.x, &t.y, &t.yaw, &t.v, &t.w, &t.accel, &t.speed_left, &t.speed_right, &t.torque_left,
-                  &t.torque_right, &t.pitch, &t.roll, &t.cmd_left, &t.cmd_right})
-    load(r, *v);
-  load(r, t.contact);
-}
+inline constexpr auto kTraceMembers =
+    std::make_tuple(&Trace::t, &Trace::x, &Trace::y, &Trace::yaw, &Trace::v, &Trace::w, &Trace::accel,
+                    &Trace::speed_left, &Trace::speed_right, &Trace::torque_left, &Trace::torque_right, &Trace::pitch,
+                    &Trace::roll, &Trace::cmd_left, &Trace::cmd_right, &Trace::contact);
+inline void save(Writer& w, const Trace& t) { saveMembers(w, t, kTraceMembers); }
+inline void load(Reader& r, Trace& t) { loadMembers(r, t, kTraceMembers); }
 
-inline void save(Writer& w, const RunPrediction& p) {
-  save(w, p.values);
-  save(w, p.features);
-  save(w, p.surface);
-  save(w, p.trace);
-  sbot::save(w, p.alignment);
-  save(w, p.notes);
-}
-inline void load(Reader& r, RunPrediction& p) {
-  load(r, p.values);
-  load(r, p.features);
-  load(r, p.surface);
-  load(r, p.trace);
-  sbot::load(r, p.alignment);
-  load(r, p.notes);
-}
+inline constexpr auto kRunPredictionMembers =
+    std::make_tuple(&RunPrediction::values, &RunPrediction::features, &RunPrediction::surface, &RunPrediction::trace,
+                    &RunPrediction::alignment, &RunPrediction::notes);
+inline void save(Writer& w, const RunPrediction& p) { saveMembers(w, p, kRunPredictionMembers); }
+inline void load(Reader& r, RunPrediction& p) { loadMembers(r, p, kRunPredictionMembers); }
 
-inline void save(Writer& w, const RunResiduals& x) {
-  save(w, x.run);
-  save(w, x.channels);
-  save(w, x.chan);
-  save(w, x.t);
-  save(w, x.r);
-  save(w, x.raw);
-  save(w, x.valid);
-  save(w, x.rss);
-  save(w, x.n);
-  save(w, x.prediction);
-}
-inline void load(Reader& r, RunResiduals& x) {
-  load(r, x.run);
-  load(r, x.channels);
-  load(r, x.chan);
-  load(r, x.t);
-  load(r, x.r);
-  load(r, x.raw);
-  load(r, x.valid);
-  load(r, x.rss);
-  load(r, x.n);
-  load(r, x.prediction);
-}
+inline constexpr auto kRunResidualsMembers =
+    std::make_tuple(&RunResiduals::run, &RunResiduals::channels, &RunResiduals::chan, &RunResiduals::t,
+                    &RunResiduals::r, &RunResiduals::raw, &RunResiduals::valid, &RunResiduals::rss, &RunResiduals::n,
+                    &RunResiduals::prediction);
+inline void save(Writer& w, const RunResiduals& x) { saveMembers(w, x, kRunResidualsMembers); }
+inline void load(Reader& r, RunResiduals& x) { loadMembers(r, x, kRunResidualsMembers); }
 
 inline void save(Writer& w, const Evaluation& e) { save(w, e.runs); }
 inline void load(Reader& r, Evaluation& e) { load(r, e.runs); }
+
+/// FitResult's members after the covariance matrix (free parameters and covariance are written by hand).
+inline constexpr auto kFitResultSummaryMembers =
+    std::make_tuple(&FitResult::rss, &FitResult::rss_start, &FitResult::n, &FitResult::rho1, &FitResult::iterations,
+                    &FitResult::evaluations, &FitResult::converged, &FitResult::evaluation);
 
 inline void save(Writer& w, const FitResult& f) {
   save(w, f.model);
@@ -113,14 +83,7 @@ inline void save(Writer& w, const FitResult& f) {
   save(w, f.stderr_);
   save<std::int64_t>(w, f.covariance.rows());
   for (Eigen::Index i = 0; i < f.covariance.size(); ++i) save(w, f.covariance.data()[i]);
-  save(w, f.rss);
-  save(w, f.rss_start);
-  save(w, f.n);
-  save(w, f.rho1);
-  save(w, f.iterations);
-  save(w, f.evaluations);
-  save(w, f.converged);
-  save(w, f.evaluation);
+  saveMembers(w, f, kFitResultSummaryMembers);
 }
 inline void load(Reader& r, FitResult& f) {
   load(r, f.model);
@@ -140,14 +103,7 @@ inline void load(Reader& r, FitResult& f) {
   load(r, n);
   f.covariance.resize(n, n);
   for (Eigen::Index i = 0; i < f.covariance.size(); ++i) load(r, f.covariance.data()[i]);
-  load(r, f.rss);
-  load(r, f.rss_start);
-  load(r, f.n);
-  load(r, f.rho1);
-  load(r, f.iterations);
-  load(r, f.evaluations);
-  load(r, f.converged);
-  load(r, f.evaluation);
+  loadMembers(r, f, kFitResultSummaryMembers);
 }
 
 }  // namespace sbot::calib
