@@ -51,6 +51,18 @@ struct SensorBridge::Impl {
   sensors::IrRayModel ir_model, ground_model;
   std::vector<Vec3> ir_dirs, ground_dirs;
 
+  // The IR and ground sensors end a reading alike: the sample's distance, incidence and surface are
+  // reported, then the effect hook and the sensor's response curve give the value (0 if not finite).
+  SensorReading respond(SensorSample s, const sensors::LogLogResponse& response) {
+    SensorReading out;
+    out.distance = s.value;
+    out.incidence = s.incidence;
+    out.surface = s.surface;
+    const double d = sensors::applyEffects(world, robot, s);
+    out.value = std::isfinite(d) ? std::min(response.signal(d), response.maxReading()) : 0.0;
+    return out;
+  }
+
   SensorReading ir(int k) {
     SensorReading out;
     auto* prox = suite->proximity();
@@ -76,12 +88,7 @@ struct SensorBridge::Impl {
         return out;
       }
     }
-    out.distance = s.value;
-    out.incidence = s.incidence;
-    out.surface = s.surface;
-    const double d = sensors::applyEffects(world, robot, s);
-    out.value = std::isfinite(d) ? std::min(prox->response().signal(d), prox->response().maxReading()) : 0.0;
-    return out;
+    return respond(s, prox->response());
   }
 
   SensorReading ground(int k) {
@@ -95,13 +102,7 @@ struct SensorBridge::Impl {
       out.value = 0;
       return out;
     }
-    SensorSample s{"ground", k, hit.mean_distance, hit.nearest.surface, hit.incidence};
-    out.distance = s.value;
-    out.incidence = s.incidence;
-    out.surface = s.surface;
-    const double d = sensors::applyEffects(world, robot, s);
-    out.value = std::isfinite(d) ? std::min(g->response().signal(d), g->response().maxReading()) : 0.0;
-    return out;
+    return respond({"ground", k, hit.mean_distance, hit.nearest.surface, hit.incidence}, g->response());
   }
 
   SensorReading light(int k) {
