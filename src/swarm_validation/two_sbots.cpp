@@ -30,7 +30,7 @@
 
 #include "experiments.h"
 #include "two_sbots_trials.h"
-#include "../common/cli_number.h"
+#include "../common/cli_args.h"
 
 namespace {
 
@@ -54,17 +54,17 @@ int main(int argc, char** argv) {
   std::vector<double> steps{0.015, 0.024, 0.032};
   bool verbose = false;
   SlopeSetup setup;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-    if (a == "--level") level = next();
-    else if (a == "--trials") trials = sbot_tools::countArg("two_sbots", a, next(), 1, 1000);
-    else if (a == "--angles") angles = parseList(a, next(), 0, 90);    // [deg]
-    else if (a == "--steps") steps = parseList(a, next(), 0, 0.2);     // [m]
+  sbot_tools::ArgReader args("two_sbots", argc, argv);
+  while (args.more()) {
+    const std::string a = args.option();
+    if (a == "--level") level = args.value();
+    else if (a == "--trials") trials = args.count(1, 1000);
+    else if (a == "--angles") angles = parseList(a, args.value(), 0, 90);    // [deg]
+    else if (a == "--steps") steps = parseList(a, args.value(), 0, 0.2);     // [m]
     else if (a == "--verbose") verbose = true;
     else if (a == "--seed-friction") setup.seed_friction = true;
     else if (a == "--rear-uphill") setup.rear_uphill = true;
-    else if (a == "--track-mu") setup.track_mu = sbot_tools::numberArg("two_sbots", a, next(), 1e-6, 100);
+    else if (a == "--track-mu") setup.track_mu = args.number(1e-6, 100);
     else {
       std::fprintf(stderr, "usage: two_sbots [--level L] [--trials N] [--angles deg,...] [--steps m,...] [--verbose] "
                            "[--seed-friction | --track-mu MU] [--rear-uphill]\n");

@@ -43,7 +43,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "course_run.h"
-#include "../common/cli_number.h"
+#include "../common/cli_args.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/scenario.h"
 #include "sbot_sim/core/swarm/level_policy.h"
@@ -126,23 +126,20 @@ ModeStats readSummary(const std::string& file) {
 
 int main(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string {
-      if (i + 1 >= argc) { std::fprintf(stderr, "%s needs a value\n", a.c_str()); std::exit(2); }
-      return argv[++i];
-    };
-    if (a == "--scenario") o.scenario = next();
-    else if (a == "--route") o.route = next();
-    else if (a == "--runs") o.runs = sbot_tools::countArg("switching_experiment", a, next(), 1, 1000);
-    else if (a == "--out") o.out = next();
-    else if (a == "--jobs") o.jobs = sbot_tools::countArg("switching_experiment", a, next(), 1, 64);
-    else if (a == "--small-gap-max") o.small_gap_max = sbot_tools::numberArg("switching_experiment", a, next(), 0, 1);
-    else if (a == "--lookahead") o.lookahead = sbot_tools::numberArg("switching_experiment", a, next(), 0, 10);
-    else if (a == "--demote-delay") o.demote_delay = sbot_tools::numberArg("switching_experiment", a, next(), 0, 1000);
+  sbot_tools::ArgReader args("switching_experiment", argc, argv);
+  while (args.more()) {
+    const std::string a = args.option();
+    if (a == "--scenario") o.scenario = args.value();
+    else if (a == "--route") o.route = args.value();
+    else if (a == "--runs") o.runs = args.count(1, 1000);
+    else if (a == "--out") o.out = args.value();
+    else if (a == "--jobs") o.jobs = args.count(1, 64);
+    else if (a == "--small-gap-max") o.small_gap_max = args.number(0, 1);
+    else if (a == "--lookahead") o.lookahead = args.number(0, 10);
+    else if (a == "--demote-delay") o.demote_delay = args.number(0, 1000);
     else if (a == "--modes") {
       o.modes.clear();
-      std::stringstream ss(next());
+      std::stringstream ss(args.value());
       for (std::string m; std::getline(ss, m, ',');) o.modes.push_back(m);
     } else {
       std::fprintf(stderr, "usage: switching_experiment [--scenario F] [--route F] [--runs N] [--out DIR] "

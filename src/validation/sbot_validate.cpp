@@ -27,7 +27,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "experiments.h"
-#include "../common/cli_number.h"
+#include "../common/cli_args.h"
 #include "two_sbots_trials.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/world_config.h"
@@ -157,20 +157,17 @@ std::string findHeightmap() {
 
 int main(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string {
-      if (i + 1 >= argc) { std::fprintf(stderr, "sbot_validate: %s needs a value\n", a.c_str()); std::exit(2); }
-      return argv[++i];
-    };
-    if (a == "--out") o.out = next();
+  sbot_tools::ArgReader args("sbot_validate", argc, argv);
+  while (args.more()) {
+    const std::string a = args.option();
+    if (a == "--out") o.out = args.value();
     else if (a == "--quick") o.quick = true;
-    else if (a == "--trials") o.trials = sbot_tools::countArg("sbot_validate", a, next(), 1, 1000);
-    else if (a == "--jobs") o.jobs = sbot_tools::countArg("sbot_validate", a, next(), 1, 64);
-    else if (a == "--heightmap") o.heightmap = next();
-    else if (a == "--trial") {  // --trial KIND LEVEL PARAM [backward]: one trial, printed (tuning aid)
-      const std::string kind = next(), level = next();
-      const double p = sbot_tools::numberArg("sbot_validate", "--trial " + kind + " " + level, next(), -1e6, 1e6);
+    else if (a == "--trials") o.trials = args.count(1, 1000);
+    else if (a == "--jobs") o.jobs = args.count(1, 64);
+    else if (a == "--heightmap") o.heightmap = args.value();
+    else if (a == "--trial") {  // --trial KIND LEVEL PARAM: one trial, printed (tuning aid)
+      const std::string kind = args.value(), level = args.value();
+      const double p = sbot_tools::numberArg(args.tool(), "--trial " + kind + " " + level, args.value(), -1e6, 1e6);
       Outcome r;
       if (kind == "gap") r = v::gapTrial(level, p, 0);
       else if (kind == "step") r = v::stepTrial(level, p, false, 0);
@@ -189,7 +186,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     else if (a == "--only") {
-      std::stringstream ss(next());
+      std::stringstream ss(args.value());
       for (std::string s; std::getline(ss, s, ',');) o.only.insert(s);
     } else {
       std::fprintf(stderr, "usage: sbot_validate --out DIR [--quick] [--trials N] [--jobs N] [--heightmap PNG]\n"

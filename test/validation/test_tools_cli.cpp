@@ -1,6 +1,7 @@
-// The headless tools' numeric options (sbot_validate, switching_experiment, two_sbots): a value that
-// is not a number in range is refused with exit status 2 and a message that names the option and
-// what was found (atoi/atof used to turn "abc" into a silent 0 runs or trials).
+// The headless tools' options (sbot_validate, switching_experiment, two_sbots; src/common/cli_args.h):
+// a missing value, or a value that is not a number in range, is refused with exit status 2 and a
+// message that names the option and what was found (atoi/atof used to turn "abc" into a silent 0 runs
+// or trials).
 #include <gtest/gtest.h>
 
 #include <string>
@@ -30,6 +31,15 @@ TEST(ToolsCli, NonNumbersAndOutOfRangeValuesAreRefusedByName) {
   expectRefused("two_sbots", "--angles 10,x", "--angles expects a number in [0, 90], found 'x'");
   expectRefused("two_sbots", "--trials 2.5", "--trials expects a whole number, found '2.5'");
   expectRefused("two_sbots", "--track-mu -1", "--track-mu expects a number");
+}
+
+// The last option without its value (two_sbots used to read it as "": --level "" then failed later
+// with an unrelated message).
+TEST(ToolsCli, AnOptionWithoutItsValueIsRefusedByName) {
+  expectRefused("sbot_validate", "--out", "sbot_validate: --out needs a value");
+  expectRefused("sbot_validate", "--trial step detailed", "sbot_validate: --trial needs a value");
+  expectRefused("switching_experiment", "--runs 2 --scenario", "switching_experiment: --scenario needs a value");
+  expectRefused("two_sbots", "--level", "two_sbots: --level needs a value");
 }
 
 TEST(ToolsCli, AValidTrialRuns) {

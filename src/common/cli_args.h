@@ -1,0 +1,67 @@
+// Command-line options of the headless tools (sbot_validate, switching_experiment, two_sbots): an
+// option missing its value, or a value that is not a finite number inside its range, is refused with
+// a message that names the tool, the option and what was found (exit status 2), instead of
+// atoi/atof's silent 0 or an empty string.
+#pragma once
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+namespace sbot_tools {
+
+inline double numberArg(const char* tool, const std::string& option, const std::string& text, double min,
+                        double max) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || !std::isfinite(v) || v < min || v > max) {
+    std::fprintf(stderr, "%s: %s expects a number in [%g, %g], found '%s'\n", tool, option.c_str(), min, max,
+                 text.c_str());
+    std::exit(2);
+  }
+  return v;
+}
+
+/// A whole number in [min, max].
+inline int countArg(const char* tool, const std::string& option, const std::string& text, int min, int max) {
+  const double v = numberArg(tool, option, text, min, max);
+  if (v != std::floor(v)) {
+    std::fprintf(stderr, "%s: %s expects a whole number, found '%s'\n", tool, option.c_str(), text.c_str());
+    std::exit(2);
+  }
+  return static_cast<int>(v);
+}
+
+/// Walks one tool's argv: option() is the next argument, value()/number()/count() the one after it.
+///   sbot_tools::ArgReader args("sbot_validate", argc, argv);
+///   while (args.more()) { const std::string a = args.option(); if (a == "--trials") trials = args.count(1, 1000); ... }
+class ArgReader {
+ public:
+  ArgReader(const char* tool, int argc, char** argv) : tool_(tool), argc_(argc), argv_(argv) {}
+  bool more() const { return i_ + 1 < argc_; }
+  const std::string& option() {
+    option_ = argv_[++i_];
+    return option_;
+  }
+  /// The current option's value; missing: exit 2 with "TOOL: OPTION needs a value".
+  std::string value() {
+    if (!more()) {
+      std::fprintf(stderr, "%s: %s needs a value\n", tool_, option_.c_str());
+      std::exit(2);
+    }
+    return argv_[++i_];
+  }
+  double number(double min, double max) { return numberArg(tool_, option_, value(), min, max); }
+  int count(int min, int max) { return countArg(tool_, option_, value(), min, max); }
+  const char* tool() const { return tool_; }
+
+ private:
+  const char* tool_;
+  int argc_;
+  char** argv_;
+  int i_ = 0;
+  std::string option_;
+};
+
+}  // namespace sbot_tools
