@@ -6,10 +6,14 @@ For every robot sbot_<i> (i < ~robots):
     its base travels at least ~min_travel (path length) or turns at least ~min_turn (a random walker
     turning on the spot at a wall is driven too), and /sbot_<i>/cmd_speed carries commands;
   - /tf carries world -> sbot_<i>/base_link (from the simulator) and sbot_<i>/base_link ->
-    sbot_<i>/turret (from /sbot_<i>/robot_state_publisher, the turret joint being revolute).
+    sbot_<i>/turret (from /sbot_<i>/robot_state_publisher, the turret joint being revolute);
+  - the robot is simulated at ~level (/sbot_<i>/model_level), and its robot_state_publisher has that
+    level's URDF: at a six-wheeled level it publishes base_link -> left_wheel_front, which only
+    moves with the simulator's joint_states of that level.
 
-Private parameters: ~robots (required), ~sim_window [s sim] to watch (default 5), ~min_travel [m]
-(default 0.05), ~min_turn [rad] (default 0.5), ~timeout [s wall] for everything to come up (default 40).
+Private parameters: ~robots (required), ~level (default simple), ~sim_window [s sim] to watch
+(default 5), ~min_travel [m] (default 0.05), ~min_turn [rad] (default 0.5), ~timeout [s wall] for
+everything to come up (default 40).
 """
 import math
 import threading
@@ -20,7 +24,7 @@ import rospy
 import rostest
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
-from sbot_msgs.msg import TrackSpeed
+from sbot_msgs.msg import ModelLevel, TrackSpeed
 from tf2_msgs.msg import TFMessage
 
 PKG = 'swarmbot3d'
@@ -31,6 +35,7 @@ class SwarmLaunchTest(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node('test_swarm_launch')
         cls.robots = int(rospy.get_param('~robots'))
+        cls.level = rospy.get_param('~level', 'simple')
         cls.sim_window = float(rospy.get_param('~sim_window', 5.0))
         cls.min_travel = float(rospy.get_param('~min_travel', 0.05))
         cls.timeout = float(rospy.get_param('~timeout', 40.0))
@@ -43,6 +48,7 @@ class SwarmLaunchTest(unittest.TestCase):
         cls.gt_count = {r: 0 for r in cls.names}
         cls.cmd_count = {r: 0 for r in cls.names}
         cls.cmd_nonzero = {r: 0 for r in cls.names}
+        cls.levels = {}       # robot -> level on its latched model_level topic
         cls.edges = {}        # (parent, child) -> set of publishing nodes
         cls.clock = None
         cls.subs = [rospy.Subscriber('/clock', Clock, cls.on_clock),
@@ -50,6 +56,7 @@ class SwarmLaunchTest(unittest.TestCase):
         for r in cls.names:
             cls.subs.append(rospy.Subscriber('/%s/ground_truth' % r, Odometry, cls.on_gt, r, queue_size=100))
             cls.subs.append(rospy.Subscriber('/%s/cmd_speed' % r, TrackSpeed, cls.on_cmd, r, queue_size=100))
+            cls.subs.append(rospy.Subscriber('/%s/model_level' % r, ModelLevel, cls.on_level, r))
 
         # Wait (wall time) until every robot has reported once, then watch sim_window of sim time.
         deadline = time.time() + cls.timeout
@@ -102,6 +109,11 @@ class SwarmLaunchTest(unittest.TestCase):
                 cls.cmd_nonzero[robot] += 1
 
     @classmethod
+    def on_level(cls, msg, robot):
+        with cls.lock:
+            cls.levels[robot] = msg.level
+
+    @classmethod
     def on_tf(cls, msg):
         node = getattr(msg, '_connection_header', {}).get('callerid', '?')
         with cls.lock:
@@ -143,6 +155,18 @@ class SwarmLaunchTest(unittest.TestCase):
                 missing.append('%s/base_link -> %s/turret from /%s/robot_state_publisher (published by %s)'
                                % (r, r, r, sorted(turret)))
         self.assertEqual(missing, [], 'missing transforms on /tf: %s' % missing)
+
+    def test_4_level_in_simulator_and_robot_state_publisher(self):
+        with self.lock:
+            levels = dict(self.levels)
+            edges = dict(self.edges)
+        wrong = {r: levels.get(r) for r in self.names if levels.get(r) != self.level}
+        self.assertEqual(wrong, {}, 'robots not simulated at level %s (model_level): %s' % (self.level, wrong))
+        if self.level in ('medium', 'detailed'):
+            missing = [r for r in self.names
+                       if '/%s/robot_state_publisher' % r not in edges.get(('%s/base_link' % r, '%s/left_wheel_front' % r), ())]
+            self.assertEqual(missing, [], 'robot_state_publisher without the %s URDF (no base_link -> left_wheel_front): %s'
+                             % (self.level, missing))
 
 
 if __name__ == '__main__':

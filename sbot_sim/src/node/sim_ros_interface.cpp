@@ -4,6 +4,7 @@
 
 #include "sbot_sim/core/effects/effects_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -52,17 +53,25 @@ bool SimRosInterface::readParams() {
     return false;
   }
   pnh_.param("robots", params_.robots, -1);
+  pnh_.param("level", params_.level, std::string());
   pnh_.param("real_time_factor", params_.real_time_factor, 1.0);
   pnh_.param("duration", params_.duration, 0.0);
   pnh_.param("publish_rate", params_.publish_rate, 50.0);
   pnh_.param("paused", params_.paused, false);
   pnh_.param("set_description_params", params_.set_description_params, false);
   pnh_.param("effects", params_.effects, std::string());
-  ROS_INFO("simulator: ~scenario=%s ~robots=%d ~real_time_factor=%g ~duration=%g ~publish_rate=%g ~paused=%s "
-           "~set_description_params=%s ~effects=%s", params_.scenario.c_str(), params_.robots,
+  ROS_INFO("simulator: ~scenario=%s ~robots=%d ~level=%s ~real_time_factor=%g ~duration=%g ~publish_rate=%g "
+           "~paused=%s ~set_description_params=%s ~effects=%s", params_.scenario.c_str(), params_.robots,
+           params_.level.empty() ? "(the scenario's)" : params_.level.c_str(),
            params_.real_time_factor, params_.duration, params_.publish_rate, params_.paused ? "true" : "false",
            params_.set_description_params ? "true" : "false",
            params_.effects.empty() ? "(the scenario's)" : params_.effects.c_str());
+  const auto& levels = sbot::modelLevels();
+  if (!params_.level.empty() && std::find(levels.begin(), levels.end(), params_.level) == levels.end()) {
+    ROS_FATAL("simulator: ~level must be fast, simple, basic, medium or detailed (empty: the scenario's levels), "
+              "got '%s'", params_.level.c_str());
+    ok = false;
+  }
   if (params_.robots < -1) {
     ROS_FATAL("simulator: ~robots must be -1 (the scenario's count) or >= 0, got %d", params_.robots);
     ok = false;
@@ -87,6 +96,9 @@ bool SimRosInterface::init() {
   if (!readParams()) return false;
   try {
     scenario_ = sbot::loadScenario(params_.scenario, params_.robots);
+    // ~level: every robot at one level (the world's step and gravity stay the scenario's).
+    if (!params_.level.empty())
+      for (sbot::RobotSpawn& r : scenario_.robots) r.level = params_.level;
     if (!params_.effects.empty()) scenario_.effects_file = params_.effects;
     world_ = buildWorld();
   } catch (const sbot::ConfigError& e) {

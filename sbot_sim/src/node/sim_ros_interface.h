@@ -31,6 +31,7 @@ namespace sbot_node {
 struct NodeParams {
   std::string scenario;          ///< ~scenario: path of the scenario YAML (required)
   int robots = -1;               ///< ~robots: robot count, -1 = the scenario's
+  std::string level;             ///< ~level: model level of every robot, "" = the scenario's
   double real_time_factor = 1.0; ///< ~real_time_factor: 0 = as fast as possible, 1 = real time
   double duration = 0;           ///< ~duration [s simulated]: 0 = the scenario's (0 there = unlimited)
   double publish_rate = 50;      ///< ~publish_rate [Hz sim]: ground truth, joint/track/turret state, tf
