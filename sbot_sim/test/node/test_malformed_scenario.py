@@ -74,6 +74,14 @@ class TestMalformedScenario(unittest.TestCase):
         path = self.fixture('three_robots.yaml')
         self.assertRefused(self.run_node('_scenario:=' + path, '_publish_rate:=-5.0'), '~publish_rate')
 
+    def test_unknown_level_override(self):
+        path = self.fixture('three_robots.yaml')
+        self.assertRefused(self.run_node('_scenario:=' + path, '_level:=huge'), '~level', "'huge'")
+
+    def test_invalid_robot_name(self):
+        path = self.fixture('bad_robot_name.yaml')
+        self.assertRefused(self.run_node('_scenario:=' + path), path, 'robots[0].name', "'sbot-0'")
+
     def test_effects_file_out_of_bounds(self):
         scenario = self.fixture('three_robots.yaml')
         effects = self.fixture('malformed.effects.yaml')
