@@ -311,8 +311,17 @@ std::string RobotDescription::extraOr(const std::string& key, const std::string&
   return it == extra.end() ? fallback : it->second;
 }
 
-double sidecarNumber(const YAML::Node& entry, const char* key, double fallback) {
-  return entry && entry[key] ? entry[key].as<double>() : fallback;
+double sidecarNumber(const RobotDescription& d, const char* entry, const char* key, double fallback) {
+  const YAML::Node e = d.sidecar[entry];
+  if (!e || !e.IsMap() || !e[key]) return fallback;
+  double v;
+  try {
+    v = e[key].as<double>();
+  } catch (const YAML::Exception&) {
+    throw ConfigError(d.sidecar_path, std::string(entry) + "." + key, "expected a number");
+  }
+  if (!std::isfinite(v)) throw ConfigError(d.sidecar_path, std::string(entry) + "." + key, "must be finite");
+  return v;
 }
 
 RobotDescription loadRobotDescription(const std::string& urdf_path, const std::string& sidecar_path) {

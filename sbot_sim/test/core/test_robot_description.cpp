@@ -9,6 +9,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <yaml-cpp/yaml.h>
+
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/sensors/sensor_common.h"
@@ -122,6 +124,25 @@ TEST(RobotDescription, TheTurretCannotBeADrivenWheel) {
   c.breakSidecar("turret: {joint: turret_joint", "turret: {joint: left_wheel_joint");
   EXPECT_NE(c.loadError().find("field 'turret.joint': 'left_wheel_joint' is a driven treels joint"), std::string::npos)
       << c.loadError();
+}
+
+// The actuator modules' optional sidecar numbers (front gripper, side arm).
+TEST(RobotDescription, ActuatorNumbersMustBeFinite) {
+  RobotDescription d;
+  d.sidecar_path = "x.sbot.yaml";
+  d.sidecar = YAML::Load("gripper: {jaw_speed: 0.5, jaw_torque: .nan, elevation_speed: fast}");
+  EXPECT_EQ(sidecarNumber(d, "gripper", "jaw_speed", 1.0), 0.5);
+  EXPECT_EQ(sidecarNumber(d, "gripper", "elevation_torque", 1.0), 1.0) << "absent: the fallback";
+  EXPECT_EQ(sidecarNumber(d, "side_arm", "unit", 2.0), 2.0) << "no entry: the fallback";
+  for (const char* key : {"jaw_torque", "elevation_speed"}) {
+    try {
+      sidecarNumber(d, "gripper", key, 1.0);
+      ADD_FAILURE() << key << " accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("x.sbot.yaml: field 'gripper." + std::string(key) + "'"), std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 // Sensor parameters in the sidecar's `extra` (kept as text, read by the sensor models).

@@ -95,10 +95,11 @@ struct RobotDescription {
   std::string extraOr(const std::string& key, const std::string& fallback) const;
 };
 
-/// The number at `key` of a structured sidecar entry (e.g. sidecar["gripper"]), or `fallback` when the
+/// The number at sidecar[entry][key] of `d` (e.g. "gripper", "jaw_speed"), or `fallback` when the
 /// entry or the key is absent. One reader for the optional parameters of the actuator modules (front
-/// gripper, side arm), which read their entries the same way.
-double sidecarNumber(const YAML::Node& entry, const char* key, double fallback);
+/// gripper, side arm). Throws ConfigError naming the sidecar and "entry.key" for a value that is not
+/// a finite number.
+double sidecarNumber(const RobotDescription& d, const char* entry, const char* key, double fallback);
 
 /// Parse one URDF and its sidecar. Throws ConfigError naming the file and field on bad input.
 RobotDescription loadRobotDescription(const std::string& urdf_path, const std::string& sidecar_path);

@@ -51,17 +51,18 @@ unsigned barrierValue(bool hit, double distance, double lo, double hi) {
 }
 
 FrontGripper::FrontGripper(World& world, Robot& robot) : world_(world), robot_(robot) {
-  const YAML::Node g = robot.description().sidecar["gripper"];
+  const RobotDescription& d = robot.description();
+  const YAML::Node g = d.sidecar["gripper"];
   std::string type = g && g["type"] ? g["type"].as<std::string>() : "none";
   if (g && g["link"]) link_ = g["link"].as<std::string>();
   if (g && g["tip_frame"]) tip_ = g["tip_frame"].as<std::string>();
   if (g && g["elevation_joint"]) elevation_joint_ = g["elevation_joint"].as<std::string>();
-  elevation_torque_ = sidecarNumber(g, "elevation_torque", elevation_torque_);
-  elevation_speed_ = sidecarNumber(g, "elevation_speed", elevation_speed_);
-  elevation_lower_ = sidecarNumber(g, "elevation_lower", elevation_lower_);
-  elevation_upper_ = sidecarNumber(g, "elevation_upper", elevation_upper_);
-  jaw_speed_ = sidecarNumber(g, "jaw_speed", jaw_speed_);
-  jaw_torque_ = sidecarNumber(g, "jaw_torque", jaw_torque_);
+  elevation_torque_ = sidecarNumber(d, "gripper", "elevation_torque", elevation_torque_);
+  elevation_speed_ = sidecarNumber(d, "gripper", "elevation_speed", elevation_speed_);
+  elevation_lower_ = sidecarNumber(d, "gripper", "elevation_lower", elevation_lower_);
+  elevation_upper_ = sidecarNumber(d, "gripper", "elevation_upper", elevation_upper_);
+  jaw_speed_ = sidecarNumber(d, "gripper", "jaw_speed", jaw_speed_);
+  jaw_torque_ = sidecarNumber(d, "gripper", "jaw_torque", jaw_torque_);
   if (g && g["jaw_joints"] && g["jaw_joints"].size() == 2) {
     jaw_upper_ = g["jaw_joints"][0].as<std::string>();
     jaw_lower_ = g["jaw_joints"][1].as<std::string>();

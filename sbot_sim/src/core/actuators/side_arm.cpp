@@ -18,7 +18,8 @@ constexpr double kProbeRadius = 0.012;  ///< [m] around the grip point between t
 }  // namespace
 
 SideArm::SideArm(World& world, Robot& robot) : world_(world), robot_(robot) {
-  const YAML::Node a = robot.description().sidecar["side_arm"];
+  const RobotDescription& d = robot.description();
+  const YAML::Node a = d.sidecar["side_arm"];
   if (!a || !a.IsMap() || !a["servos"]) return;
   const YAML::Node s = a["servos"];
   auto str = [&](const char* k) { return s[k] ? s[k].as<std::string>() : std::string(); };
@@ -28,20 +29,20 @@ SideArm::SideArm(World& world, Robot& robot) : world_(world), robot_(robot) {
   j_jaw_a_ = str("jaw_a");
   j_jaw_b_ = str("jaw_b");
   tip_link_ = a["tip_link"] ? a["tip_link"].as<std::string>() : "side_arm_tip_a";
-  unit_ = sidecarNumber(a, "unit", unit_);
-  s_ = sidecarNumber(a, "link_length", s_);
-  rhombi_ = static_cast<int>(sidecarNumber(a, "rhombi", rhombi_));
-  a0_ = sidecarNumber(a, "rest_half_angle", a0_);
-  a_min_ = sidecarNumber(a, "half_angle_min", a_min_);
-  a_max_ = sidecarNumber(a, "half_angle_max", a_max_);
-  rotation_range_ = sidecarNumber(a, "rotation_range", rotation_range_);
-  elevation_torque_ = sidecarNumber(a, "elevation_torque", elevation_torque_);
-  horizontal_torque_ = sidecarNumber(a, "horizontal_torque", horizontal_torque_);
-  servo_speed_ = sidecarNumber(a, "servo_speed", servo_speed_);
-  jaw_force_ = sidecarNumber(a, "jaw_force", jaw_force_);
-  jaw_torque_ = sidecarNumber(a, "jaw_torque", jaw_torque_);
-  jaw_speed_ = sidecarNumber(a, "jaw_speed", jaw_speed_);
-  aperture_max_ = sidecarNumber(a, "aperture_max", aperture_max_);
+  unit_ = sidecarNumber(d, "side_arm", "unit", unit_);
+  s_ = sidecarNumber(d, "side_arm", "link_length", s_);
+  rhombi_ = static_cast<int>(sidecarNumber(d, "side_arm", "rhombi", rhombi_));
+  a0_ = sidecarNumber(d, "side_arm", "rest_half_angle", a0_);
+  a_min_ = sidecarNumber(d, "side_arm", "half_angle_min", a_min_);
+  a_max_ = sidecarNumber(d, "side_arm", "half_angle_max", a_max_);
+  rotation_range_ = sidecarNumber(d, "side_arm", "rotation_range", rotation_range_);
+  elevation_torque_ = sidecarNumber(d, "side_arm", "elevation_torque", elevation_torque_);
+  horizontal_torque_ = sidecarNumber(d, "side_arm", "horizontal_torque", horizontal_torque_);
+  servo_speed_ = sidecarNumber(d, "side_arm", "servo_speed", servo_speed_);
+  jaw_force_ = sidecarNumber(d, "side_arm", "jaw_force", jaw_force_);
+  jaw_torque_ = sidecarNumber(d, "side_arm", "jaw_torque", jaw_torque_);
+  jaw_speed_ = sidecarNumber(d, "side_arm", "jaw_speed", jaw_speed_);
+  aperture_max_ = sidecarNumber(d, "side_arm", "aperture_max", aperture_max_);
   if (const JointDescription* j = robot.description().findJoint(j_elev_)) elev_range_ = std::min(-j->lower, j->upper);
   available_ = robot.hingeJoint(j_elev_) && robot.hingeJoint(j_left_) && robot.hingeJoint(j_right_);
   if (available_ && a["loop_joints"]) closeLoops(a["loop_joints"]);
