@@ -1,10 +1,12 @@
 // sbot_bench: how fast the headless core simulates swarms. Not a test: it prints figures.
 //
-//   sbot_bench [--level simple] [--robots 1,10,100] [--seconds 20] [--step 0.01] [--chains K]
+//   sbot_bench [--level simple] [--robots 1,10,100] [--seconds 20] [--step 0.01] [--chains K] [--profile]
 //
 // --chains K: the robots form chains of K connected by static front-gripper links (robot i+1 grips
 // robot i; core/swarm/swarm_graph.h), each chain driving one random-walk command, and the swarm graph
 // (computeSwarmGraph, as /swarm/graph) is computed at 10 Hz; its cost is part of the timing.
+// --profile: also print where the step time goes (World::enableProfile): solver, collision
+// detection, motor commands, feedback, and the contact joints per step.
 //
 // For every robot count it runs, in a fresh child process (so peak memory is that run's own), a
 // swarm doing a random walk on a flat arena, and prints the real-time multiplier RTM (simulated s
@@ -34,6 +36,7 @@ struct Options {
   double seconds = 20;
   double step = 0;  // 0: the level's recommended step
   int chains = 0;   // robots per chain, 0 = unconnected
+  bool profile = false;
 };
 
 Options parse(int argc, char** argv) {
@@ -48,12 +51,13 @@ Options parse(int argc, char** argv) {
     else if (a == "--seconds") o.seconds = std::atof(next().c_str());
     else if (a == "--step") o.step = std::atof(next().c_str());
     else if (a == "--chains") o.chains = std::atoi(next().c_str());
+    else if (a == "--profile") o.profile = true;
     else if (a == "--robots") {
       o.robots.clear();
       std::stringstream ss(next());
       for (std::string n; std::getline(ss, n, ',');) o.robots.push_back(std::atoi(n.c_str()));
     } else {
-      std::fprintf(stderr, "usage: sbot_bench [--level L] [--robots 1,10,100] [--seconds S] [--step DT] [--chains K]\n");
+      std::fprintf(stderr, "usage: sbot_bench [--level L] [--robots 1,10,100] [--seconds S] [--step DT] [--chains K] [--profile]\n");
       std::exit(a == "--help" ? 0 : 2);
     }
   }
@@ -98,6 +102,7 @@ void runOne(const Options& o, int n) {
   std::size_t components = 0;
   const int steps = static_cast<int>(o.seconds / c.step);
   const int change_every = static_cast<int>(1.0 / c.step);  // new random command every simulated second
+  w.enableProfile(o.profile);
   const auto t0 = std::chrono::steady_clock::now();
   for (int s = 0; s < steps; ++s) {
     if (s % change_every == 0) {
@@ -123,6 +128,12 @@ void runOne(const Options& o, int n) {
     // CPU-time RTM too: on a shared machine the wall clock includes waiting for a core.
     const double cpu = ru.ru_utime.tv_sec + 1e-6 * ru.ru_utime.tv_usec + ru.ru_stime.tv_sec + 1e-6 * ru.ru_stime.tv_usec;
     std::printf("   chains of %d, %zu components at the end, RTM by CPU time %.1f", k, components, w.time() / cpu);
+  }
+  if (o.profile) {
+    const sbot::World::StepProfile& p = w.profile();
+    std::printf("   solver %.0f %%, collision %.0f %%, commands %.0f %%, feedback %.0f %%, %.1f contacts/step",
+                100 * p.solver_s / wall, 100 * p.collision_s / wall, 100 * p.commands_s / wall,
+                100 * p.feedback_s / wall, static_cast<double>(p.contacts) / static_cast<double>(p.steps));
   }
   std::printf("\n");
   std::fflush(stdout);

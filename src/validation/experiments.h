@@ -58,6 +58,18 @@ Outcome roughTrial(const std::string& level, double hr_mm, int trial, const std:
 /// step, over `sim_seconds`. value = RTM, value2 = wall ms per step.
 Outcome rtmTrial(const std::string& level, double sim_seconds, bool with_sensors = true);
 
+/// Where one s-bot's step time goes (Table 4.4's workload, its level's sensors read every step), as
+/// fractions of the wall time. The rest (1 - the fractions) is the loop itself and clock reads.
+struct StepCost {
+  double rtm = 0;                ///< simulated / wall seconds, profiling on
+  double wall_us_per_step = 0;   ///< [us]
+  double commands = 0, collision = 0, solver = 0, feedback = 0, sensors = 0;  ///< fractions of wall time
+  double contacts_per_step = 0;  ///< contact joints the solver gets per step
+  int bodies = 0;                ///< ODE bodies of the robot
+  int iterations = 0;            ///< quickstep iterations in use
+};
+StepCost profileTrial(const std::string& level, double sim_seconds);
+
 /// Seed 2.1.3: steady speed [m/s] at setSpeed(units, units) on flat ground (value).
 Outcome steadySpeedTrial(const std::string& level, int units);
 

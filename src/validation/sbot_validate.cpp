@@ -143,6 +143,28 @@ void plotFig44(const std::string& path, const std::vector<double>& hrs,
   cv::imwrite(path, img);
 }
 
+/// Table 4.4's "what limits it": the step time of one s-bot per level split by phase
+/// (World::enableProfile, sensors timed around their reads). Runs in this process, one level after
+/// the other, so the figures are comparable with each other rather than with the RTM column above.
+void writeProfile(std::ostream& md, bool quick) {
+  const std::map<std::string, double> seconds{{"fast", 1000}, {"simple", 100}, {"medium", 50}, {"detailed", 20}};
+  md << "### What limits it: where one step's time goes\n\n"
+     << "The same workload, timed by phase (`World::enableProfile`; sensors timed around their reads; "
+        "the rest is the loop and the clock reads). collision = broad and narrow phase and the contact "
+        "joints built; solver = ODE's quickstep over bodies, joints and contacts; commands = motors and "
+        "effects; feedback = wheel loads and torque windows.\n\n"
+     << "| level | bodies | contacts per step | solver iterations | us per step | solver | collision | sensors | "
+        "commands | feedback | RTM (profiling) |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+  auto pct = [](double f) { return fmt(100 * f, 0) + " %"; };
+  for (const auto& level : kLevels) {
+    const v::StepCost c = v::profileTrial(level, quick ? seconds.at(level) / 3 : seconds.at(level));
+    md << "| " << level << " | " << c.bodies << " | " << fmt(c.contacts_per_step, 1) << " | " << c.iterations << " | "
+       << fmt(c.wall_us_per_step, 1) << " | " << pct(c.solver) << " | " << pct(c.collision) << " | " << pct(c.sensors)
+       << " | " << pct(c.commands) << " | " << pct(c.feedback) << " | " << fmt(c.rtm, 0) << " |\n";
+  }
+  md << "\n";
+}
+
 std::string findHeightmap() {
   const char* env = std::getenv("SBOT_HEIGHTMAP");
   if (env) return env;
@@ -436,6 +458,7 @@ int main(int argc, char** argv) {
          << (r[0].value >= target ? "yes" : "**no**") << " | " << fmt(p[0].value, 0) << " |\n";
     }
     md << "\n";
+    writeProfile(md, o.quick);
   }
 
   // ---- Compatibility (2.1.3) -------------------------------------------------------------------

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -205,14 +206,31 @@ std::vector<Robot*> World::robots() {
   return out;
 }
 
+void World::enableProfile(bool on) {
+  profiling_ = on;
+  profile_ = StepProfile{};
+}
+
 void World::step() {
+  using Clock = std::chrono::steady_clock;
+  // Phase boundaries; each lap adds the time since the previous one to its phase (profiling only).
+  Clock::time_point mark;
+  if (profiling_) mark = Clock::now();
+  auto lap = [&](double& phase) {
+    if (!profiling_) return;
+    const Clock::time_point now = Clock::now();
+    phase += std::chrono::duration<double>(now - mark).count();
+    mark = now;
+  };
   const double dt = config_.step;
   for (auto& r : robots_) r->applyCommands(dt, effects_);
+  lap(profile_.commands_s);
   dSpaceCollide(space_, this, &nearCallback);  // robot against robot
   // Robot against terrain: each static geom's AABB against the robot's space, then the robot's
   // geoms against the few static geoms that overlap it.
   for (auto& r : robots_)
     dSpaceCollide2(reinterpret_cast<dGeomID>(static_space_), reinterpret_cast<dGeomID>(r->space()), this, &nearCallback);
+  lap(profile_.collision_s);
   // QuickStep shuffles constraints with ODE's one global generator; reseeding it from the step
   // count makes every run of a scenario bit-identical whatever other worlds did in this process.
   // (Worlds in parallel threads would share that generator: run parallel simulations as processes.)
@@ -221,9 +239,12 @@ void World::step() {
     dWorldStep(world_, dt);
   else
     dWorldQuickStep(world_, dt);
+  lap(profile_.solver_s);
   updateDriveWheelLoads();
   dJointGroupEmpty(contacts_);
   for (auto& r : robots_) r->readFeedback(dt);
+  lap(profile_.feedback_s);
+  ++profile_.steps;
   time_ += dt;
   ++steps_;
 }
@@ -278,6 +299,7 @@ void World::handlePair(dGeomID a, dGeomID b) {
       for (int k = 0; k < 3; ++k) contacts[i].fdir1[k] = ctx.fdir1[k];
     }
     dJointID c = dJointCreateContact(world_, contacts_, &contacts[i]);
+    ++profile_.contacts;
     dJointAttach(c, ba, bb);
     const bool wheel_a = ia && ia->drive_wheel, wheel_b = ib && ib->drive_wheel;
     if (wheel_a || wheel_b) {
