@@ -48,6 +48,7 @@ std::vector<double> parseList(const std::string& option, const std::string& s, d
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (!sbot::validation::studyKnobsOk("two_sbots")) return 2;
   std::string level = "detailed";
   int trials = 3;
   std::vector<double> angles{10, 20, 25, 29, 32, 35, 40, 45, 50, 55, 58, 65, 72};

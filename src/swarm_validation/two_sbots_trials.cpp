@@ -12,7 +12,7 @@
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/swarm/swarm_graph.h"
 #include "sbot_sim/core/world.h"
-#include "experiments.h"  // kToppledTilt
+#include "experiments.h"  // kToppledTilt, applyStudyKnobs
 
 namespace two_sbots {
 
@@ -23,11 +23,6 @@ namespace {
 double tiltOf(const Robot& r) {
   const Vec3 up = r.basePose().orientation * Vec3::UnitZ();
   return std::acos(std::max(-1.0, std::min(1.0, up.z())));
-}
-
-/// $SBOT_VALIDATE_WELD: the opt-in turret weld, as sbot_validate reads it (src/validation/README.md).
-void studyKnobs(WorldConfig& c) {
-  if (std::getenv("SBOT_VALIDATE_WELD")) c.lock_idle_turret = true;
 }
 
 }  // namespace
@@ -43,7 +38,7 @@ SlopeResult pairSlope(const std::string& level, double angle, int trial, const S
   } else if (setup.track_mu > 0) {
     c.contact.material_mu["track"] = setup.track_mu;
   }
-  studyKnobs(c);
+  validation::applyStudyKnobs(c);  // the solver study knobs, as sbot_validate
   World w(c);
   const double g = c.gravity;
   dWorldSetGravity(w.odeWorld(), -g * std::sin(angle), 0, -g * std::cos(angle));
@@ -108,7 +103,7 @@ StepResult stepBackward(const std::string& level, double h, int trial, bool pair
   c.seed = 8000 + trial;
   c.terrain.type = TerrainConfig::Type::Composite;
   c.terrain.boxes.push_back({"step", Vec3(-1.0, 0, h / 2), Vec3(2.0, 1.0, h), 0, 0, "ground"});
-  studyKnobs(c);
+  validation::applyStudyKnobs(c);  // the solver study knobs, as sbot_validate
   World w(c);
   std::mt19937 rng(trial * 977 + static_cast<int>(h * 1e4));
   std::uniform_real_distribution<double> u(-1, 1);

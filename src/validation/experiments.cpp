@@ -14,6 +14,7 @@
 #include <random>
 #include <sstream>
 
+#include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/sensors/environment.h"
 #include "sbot_sim/core/sensors/sensor_suite.h"
@@ -36,12 +37,7 @@ WorldConfig configFor(const RobotDescription& d, std::uint64_t seed) {
   // The World raises the quickstep iterations to the level's need (RobotDescription::
   // solver_iterations; Detailed: 40: at 20 the 22-body model jitters at rest (~0.5 rad/s), sits
   // nose-down and topples off steps it climbs cleanly at 40 and above).
-  if (const char* e = std::getenv("SBOT_VALIDATE_ITERATIONS")) {  // override (study of the solver)
-    c.solver_iterations = std::atoi(e);
-    c.level_iterations = false;
-  }
-  if (const char* e = std::getenv("SBOT_VALIDATE_SOLVER")) c.solver = e;  // quickstep | exact (study)
-  if (std::getenv("SBOT_VALIDATE_WELD")) c.lock_idle_turret = true;       // opt-in turret weld (study)
+  applyStudyKnobs(c);
   return c;
 }
 
@@ -128,6 +124,34 @@ Robot& spawn(World& w, const RobotDescription& d, const Pose2D& p) {
 }
 
 }  // namespace
+
+void applyStudyKnobs(WorldConfig& c) {
+  if (const char* e = std::getenv("SBOT_VALIDATE_ITERATIONS")) {
+    char* end = nullptr;
+    const long n = std::strtol(e, &end, 10);
+    if (end == e || *end != '\0' || n < 1 || n > 10000)
+      throw ConfigError("$SBOT_VALIDATE_ITERATIONS", "", std::string("expected a whole number in [1, 10000], found '") + e + "'");
+    c.solver_iterations = static_cast<int>(n);
+    c.level_iterations = false;
+  }
+  if (const char* e = std::getenv("SBOT_VALIDATE_SOLVER")) {
+    c.solver = e;
+    if (c.solver != "quickstep" && c.solver != "exact")
+      throw ConfigError("$SBOT_VALIDATE_SOLVER", "", "expected 'quickstep' or 'exact', found '" + c.solver + "'");
+  }
+  if (std::getenv("SBOT_VALIDATE_WELD")) c.lock_idle_turret = true;
+}
+
+bool studyKnobsOk(const char* tool) {
+  try {
+    WorldConfig c;
+    applyStudyKnobs(c);
+    return true;
+  } catch (const ConfigError& e) {
+    std::fprintf(stderr, "%s: %s\n", tool, e.what());
+    return false;
+  }
+}
 
 // ---- Table 4.2 / 4.5: gap ------------------------------------------------------------------------
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 namespace sbot {
+struct WorldConfig;
 namespace validation {
 
 struct Outcome {
@@ -25,6 +26,14 @@ struct Outcome {
 /// Table 4.1 (single and connected s-bots): a robot tilted more than this off the slope's normal has
 /// toppled. Not 60 deg: one tipped forward onto its held gripper rests at 56-59 deg.
 constexpr double kToppledTilt = 45 * 3.14159265358979323846 / 180;  // [rad]
+
+/// The solver study knobs every validation world honours (README "Solver"):
+/// $SBOT_VALIDATE_ITERATIONS (quickstep iterations, overriding the levels' own), $SBOT_VALIDATE_SOLVER
+/// (quickstep | exact) and $SBOT_VALIDATE_WELD (the opt-in turret weld).
+/// Throws ConfigError naming the variable for a value it cannot use.
+void applyStudyKnobs(WorldConfig& c);
+/// Whether the study knobs are usable; if not, prints "TOOL: what is wrong" (call before any trial).
+bool studyKnobsOk(const char* tool);
 
 /// Speed used by the seed for gap and slope experiments (4.2.3, 4.2.4): 2.8 cm/s = 10 API units.
 constexpr int kSlowUnits = 10;

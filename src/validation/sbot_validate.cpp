@@ -178,6 +178,7 @@ std::string findHeightmap() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (!v::studyKnobsOk("sbot_validate")) return 2;
   Options o;
   sbot_tools::ArgReader args("sbot_validate", argc, argv);
   while (args.more()) {

@@ -42,6 +42,28 @@ TEST(ToolsCli, AnOptionWithoutItsValueIsRefusedByName) {
   expectRefused("two_sbots", "--level", "two_sbots: --level needs a value");
 }
 
+// The solver study knobs (src/validation/README.md "Solver") are read from the environment by both
+// tools; a value they cannot use stops them before any trial (an unparsable iteration count used to
+// become 0 iterations through atoi).
+TEST(ToolsCli, UnusableStudyKnobsAreRefusedByName) {
+  for (const std::string tool : {"sbot_validate", "two_sbots"}) {
+    const std::string bin = std::string(SWARMBOT3D_BIN_DIR) + "/" + tool;
+    Outcome o = sbot_test::runProcess("env SBOT_VALIDATE_ITERATIONS=12x " + bin + " --trial step detailed 0.010");
+    EXPECT_EQ(o.status, 2) << o.output;
+    EXPECT_NE(o.output.find(tool + ": $SBOT_VALIDATE_ITERATIONS: expected a whole number in [1, 10000], found '12x'"),
+              std::string::npos) << o.output;
+    o = sbot_test::runProcess("env SBOT_VALIDATE_SOLVER=fast " + bin + " --trial step detailed 0.010");
+    EXPECT_EQ(o.status, 2) << o.output;
+    EXPECT_NE(o.output.find("$SBOT_VALIDATE_SOLVER: expected 'quickstep' or 'exact', found 'fast'"), std::string::npos)
+        << o.output;
+  }
+  // A usable value is taken: one trial at 60 iterations.
+  const Outcome o = sbot_test::runProcess("env SBOT_VALIDATE_ITERATIONS=60 " + std::string(SWARMBOT3D_BIN_DIR) +
+                                          "/sbot_validate --trial step detailed 0.010");
+  EXPECT_EQ(o.status, 0) << o.output;
+  EXPECT_NE(o.output.find("step detailed 0.01: pass"), std::string::npos) << o.output;
+}
+
 TEST(ToolsCli, AValidTrialRuns) {
   const Outcome o = run("sbot_validate", "--trial step detailed 0.010");
   EXPECT_EQ(o.status, 0) << o.output;
