@@ -12,7 +12,7 @@
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/swarm/swarm_graph.h"
 #include "sbot_sim/core/world.h"
-#include "experiments.h"  // kToppledTilt, applyStudyKnobs
+#include "experiments.h"  // kToppledTilt, kUprightTilt, applyStudyKnobs
 
 namespace two_sbots {
 
@@ -160,12 +160,16 @@ StepResult stepBackward(const std::string& level, double h, int trial, bool pair
     }
     w.step();
     if (grip) grip->update(c.step);
-    if (tiltOf(a) > 75 * M_PI / 180 || (b && tiltOf(*b) > 75 * M_PI / 180)) {
+    // The same toppled and upright tilts as the single-robot tables (validation::kToppledTilt).
+    if (tiltOf(a) > validation::kToppledTilt || (b && tiltOf(*b) > validation::kToppledTilt)) {
       toppled = true;
       break;
     }
-    const bool a_up = a.basePose().position.x() < -0.10 && a.basePose().position.z() > h;
-    const bool b_up = !b || (b->basePose().position.x() < -0.10 && b->basePose().position.z() > h);
+    auto onTop = [h](const Robot& r) {
+      return r.basePose().position.x() < -0.10 && r.basePose().position.z() > h && tiltOf(r) < validation::kUprightTilt;
+    };
+    const bool a_up = onTop(a);
+    const bool b_up = !b || onTop(*b);
     if (a_up && b_up) {
       res.label = "pass";
       break;

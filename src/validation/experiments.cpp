@@ -62,13 +62,34 @@ double headingOf(const Robot& r) {
 /// Steps between two calls of runFor's check: ~0.05 s (every step for Fast's 0.1 s).
 int checkEvery(const World& w) { return std::max(1, static_cast<int>(std::lround(0.05 / w.config().step))); }
 
+bool g_trace = false;  // setTrace
+
+/// One line of the --trace output (every 0.1 s of simulated time): the first robot's base pose and attitude, its driven wheels'
+/// load and the front gripper tip's height (what decides most of the tables' cells).
+void traceLine(World& w) {
+  const std::vector<Robot*> robots = w.robots();
+  if (robots.empty()) return;
+  const Robot& r = *robots.front();
+  const Pose b = r.basePose();
+  const Vec3 f = b.orientation * Vec3::UnitX();
+  const Vec3 l = b.orientation * Vec3::UnitY();
+  const double deg = 180 / M_PI;
+  std::printf("  t %6.2f s  x %7.4f  y %7.4f  z %7.4f m  pitch %6.1f  roll %6.1f  yaw %6.1f deg  wheel load %5.2f N",
+              w.time(), b.position.x(), b.position.y(), b.position.z(), -std::asin(f.z()) * deg, std::asin(l.z()) * deg,
+              std::atan2(f.y(), f.x()) * deg, r.driveWheelLoad());
+  if (r.description().findLink("gripper_tip")) std::printf("  gripper tip z %7.4f m", r.linkPose("gripper_tip").position.z());
+  std::printf("\n");
+}
+
 /// Step `w` for `seconds`, calling `check` every checkEvery(w) steps (~0.05 s); stop when it returns true.
 template <typename F>
 void runFor(World& w, double seconds, F check) {
   const int every = checkEvery(w);
+  const int trace_every = std::max(1, static_cast<int>(std::lround(0.1 / w.config().step)));
   const int steps = static_cast<int>(std::ceil(seconds / w.config().step));
   for (int s = 0; s < steps; ++s) {
     w.step();
+    if (g_trace && (s + 1) % trace_every == 0) traceLine(w);
     if ((s + 1) % every == 0 && check()) return;
   }
 }
@@ -125,6 +146,8 @@ Robot& spawn(World& w, const RobotDescription& d, const Pose2D& p) {
 
 }  // namespace
 
+void setTrace(bool on) { g_trace = on; }
+
 void applyStudyKnobs(WorldConfig& c) {
   if (const char* e = std::getenv("SBOT_VALIDATE_ITERATIONS")) {
     char* end = nullptr;
@@ -178,8 +201,11 @@ Outcome gapTrial(const std::string& level, double gap_m, int trial) {
   const double goal = gap / 2 + 0.09 * s;
   runFor(w, (gap + 0.30 * s) / kSlowSpeed + 4.0, [&] {
     const Vec3 p = r.basePose().position;
-    if (angleBetween(upOf(r), Vec3::UnitZ()) > 80 * M_PI / 180) { o.label = "topple"; return true; }
-    if (p.x() > goal && p.z() > z0 - 0.01 * s) { o.label = "pass"; return true; }
+    const double tilt = angleBetween(upOf(r), Vec3::UnitZ());
+    // Not kToppledTilt: a robot wedged nose-first in the gap at 50-70 deg has fallen inside (the
+    // seed's Figure 4.1), it has not toppled; toppling here is going over on its back or side.
+    if (tilt > 80 * M_PI / 180) { o.label = "topple"; return true; }
+    if (p.x() > goal && p.z() > z0 - 0.01 * s && tilt < kUprightTilt) { o.label = "pass"; return true; }
     return false;
   });
   o.value = r.basePose().position.x();
@@ -208,8 +234,11 @@ Outcome stepTrial(const std::string& level, double height_m, bool backward, int 
   Outcome o{"fail"};
   runFor(w, 0.25 * s / kSlowSpeed + 8.0, [&] {
     const Vec3 p = r.basePose().position;
-    if (angleBetween(upOf(r), Vec3::UnitZ()) > 80 * M_PI / 180) { o.label = "topple"; return true; }
-    if (p.x() > 0.09 * s && p.z() > z0 + height_m - 0.006) { o.label = "pass"; return true; }
+    const double tilt = angleBetween(upOf(r), Vec3::UnitZ());
+    // A robot that reverses up a step nose-first onto its held gripper stands at 70-77 deg and can
+    // be carried onto the step that way (its base then lies high): toppled, not passed.
+    if (tilt > kToppledTilt) { o.label = "topple"; return true; }
+    if (p.x() > 0.09 * s && p.z() > z0 + height_m - 0.006 && tilt < kUprightTilt) { o.label = "pass"; return true; }
     return false;
   });
   o.value = r.basePose().position.x();

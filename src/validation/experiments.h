@@ -23,13 +23,22 @@ struct Outcome {
   double value2 = 0;        ///< second measurement (heading change [rad], slide [m], ...)
 };
 
-/// Table 4.1 (single and connected s-bots): a robot tilted more than this off the slope's normal has
-/// toppled. Not 60 deg: one tipped forward onto its held gripper rests at 56-59 deg.
+/// Tables 4.1 and 4.3 (single and connected s-bots): a robot tilted more than this off the slope's
+/// (or the floor's) normal has toppled. Not 60 or 80 deg: one tipped forward onto its held gripper
+/// rests at 56-59 deg on a slope, and stands at 70-77 deg after reversing into a step. (In a gap a
+/// robot wedged nose-first has fallen inside: gapTrial counts only going over, > 80 deg.)
 constexpr double kToppledTilt = 45 * 3.14159265358979323846 / 180;  // [rad]
+
+/// Gap and step passes: the robot is on its tracks at the end, tilted less than this.
+constexpr double kUprightTilt = 20 * 3.14159265358979323846 / 180;  // [rad]
 
 /// The solver study knobs every validation world honours (README "Solver"):
 /// $SBOT_VALIDATE_ITERATIONS (quickstep iterations, overriding the levels' own), $SBOT_VALIDATE_SOLVER
 /// (quickstep | exact) and $SBOT_VALIDATE_WELD (the opt-in turret weld).
+/// Print the first robot's state every 0.1 s of simulated time while the experiments run (the
+/// `sbot_validate --trace --trial ...` tuning aid). Pitch > 0 is nose down.
+void setTrace(bool on);
+
 /// Throws ConfigError naming the variable for a value it cannot use.
 void applyStudyKnobs(WorldConfig& c);
 /// Whether the study knobs are usable; if not, prints "TOOL: what is wrong" (call before any trial).

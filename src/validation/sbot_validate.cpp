@@ -6,6 +6,11 @@
 // LIST: comma-separated sections of 4.1,4.1pair,4.2,4.3,4.4,4.5,4.6,fig4.4,compat (default: all).
 // --quick: 3 trials per cell and 4 runs per roughness (minutes instead of tens of minutes).
 // Exit status: 0 when every hardware cell of Tables 4.1-4.3 matches, 1 otherwise, 2 on bad usage.
+//
+//   sbot_validate [--trace] --trial KIND LEVEL PARAM    one trial, printed (tuning aid); --trace
+//                                                        prints the robot's state every 0.1 s
+// KIND: gap, step, stepb, slope, slopeb, uphill, downhill, rough, rtm (PARAM: m, m, m, deg, deg,
+// rad, rad, HR in mm, simulated s).
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -188,6 +193,7 @@ int main(int argc, char** argv) {
     else if (a == "--trials") o.trials = args.count(1, 1000);
     else if (a == "--jobs") o.jobs = args.count(1, 64);
     else if (a == "--heightmap") o.heightmap = args.value();
+    else if (a == "--trace") v::setTrace(true);  // with --trial (before it): the robot's state every 0.1 s
     else if (a == "--trial") {  // --trial KIND LEVEL PARAM: one trial, printed (tuning aid)
       const std::string kind = args.value(), level = args.value();
       const double p = sbot_tools::numberArg(args.tool(), "--trial " + kind + " " + level, args.value(), -1e6, 1e6);

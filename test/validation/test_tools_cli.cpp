@@ -4,6 +4,8 @@
 // or trials).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <string>
 
 #include "../common/run_process.h"
@@ -68,6 +70,24 @@ TEST(ToolsCli, AValidTrialRuns) {
   const Outcome o = run("sbot_validate", "--trial step detailed 0.010");
   EXPECT_EQ(o.status, 0) << o.output;
   EXPECT_NE(o.output.find("step detailed 0.01: pass"), std::string::npos) << o.output;
+  EXPECT_EQ(o.output.find("pitch"), std::string::npos) << "no trace unless asked";
+}
+
+// --trace prints the robot's state every 0.1 s: here the Detailed model reversing into a 10 mm step
+// tips nose down toward its gripper; the trial stops as a topple once it is 45 deg off the vertical
+// (it used to drive on standing on its gripper at 70-77 deg and count as a pass).
+TEST(ToolsCli, TraceShowsTheRobotTippingOntoItsGripper) {
+  const Outcome o = run("sbot_validate", "--trace --trial stepb detailed 0.010");
+  EXPECT_EQ(o.status, 0) << o.output;
+  EXPECT_NE(o.output.find("stepb detailed 0.01: topple"), std::string::npos) << o.output;
+  double max_pitch = 0;
+  int lines = 0;
+  for (std::size_t at = o.output.find("pitch"); at != std::string::npos; at = o.output.find("pitch", at + 1)) {
+    max_pitch = std::max(max_pitch, std::atof(o.output.c_str() + at + 5));
+    ++lines;
+  }
+  EXPECT_GT(lines, 20) << o.output;
+  EXPECT_GT(max_pitch, 30.0) << o.output;
 }
 
 }  // namespace

@@ -26,10 +26,11 @@ struct Cell {
   std::function<v::Outcome()> run;
 };
 
-// Our Detailed model climbs 18 mm backward and ~26 mm forward, and crosses 55 mm gaps (the held
-// front gripper props it on the far edge): see the README.
+// Our Detailed model climbs ~26 mm forward, crosses 55 mm gaps (the held front gripper props it on
+// the far edge), and tips forward onto its gripper when it reverses up any step from 10 mm: see
+// the README.
 const std::set<std::string> kKnownMismatch{"gap 55 mm (Table 4.2)", "step 24 mm forward (Table 4.3)",
-                                           "step 16 mm backward (Table 4.3)"};
+                                           "step 15 mm backward (Table 4.3)"};
 
 }  // namespace
 
