@@ -2,15 +2,24 @@
 """Benchmark the simulator node with its topics (the ROS counterpart of sbot_bench).
 
     rosrun swarmbot3d node_bench.py [--robots 1,10,100] [--seconds 10]
+    rosrun swarmbot3d node_bench.py --chains 5 [--robots 100] [--seconds 20]
 
 For each robot count it starts its own ROS master on a free port, runs simulator_node on
 config/scenarios/bench_flat.yaml for `seconds` of simulated time while `rosbag record` subscribes
 to every topic but the raw camera images (so every sensor is computed and every message serialised
 and sent), and prints the real-time multiplier
 (simulated s / wall s), wall time per step and the node's peak resident memory.
+
+--chains K (issue "Scale", seed 2.3): the robots stand in chains of K linked by static front-gripper
+links (scenario `links:`), headless and unrecorded; a driver node sends every chain one random
+command per simulated second on the robots' cmd_speed topics (all members the same, as sbot_bench
+--chains does) and counts the /swarm/graph messages (published at the node's default 10 Hz) and the
+swarm-bots (connected components) they report.
 """
 import argparse
+import json
 import os
+import random
 import re
 import signal
 import socket
@@ -39,21 +48,95 @@ def peak_rss_mib(pid):
     return float('nan')
 
 
-def run(robots, seconds, scenario):
+CHAIN_PITCH = 0.147  # [m] centre distance of two s-bots linked by the front gripper (docs/swarm.md)
+
+
+def chain_scenario(robots, k, path):
+    """A walled flat arena with `robots` Simple s-bots in chains of `k` (sbot_<i+1> holds sbot_<i>),
+    the chains on a grid of cells as sbot_bench --chains lays them out."""
+    chains = (robots + k - 1) // k
+    side = max(1, int(round(chains ** 0.5 + 0.4999)))
+    dx, dy = CHAIN_PITCH * k + 0.3, 0.35
+    arena = max(side * dx, side * dy) + 1.0
+    lines = ['name: node_bench_chains', 'seed: 1', 'duration: 0', 'world:', '  step: 0.01', '  terrain:',
+             '    type: plane', '    arena: {size: %.3f, height: 0.1, surface: wall}' % arena, 'robots:']
+    links = []
+    for i in range(robots):
+        c, j = divmod(i, k)  # chain c, member j (j = 0 leads, at the front)
+        cx = (c % side - (side - 1) / 2.0) * dx + CHAIN_PITCH * (k - 1) / 2.0
+        cy = (c // side - (side - 1) / 2.0) * dy
+        lines.append('  - {name: sbot_%d, level: simple, pose: {x: %.4f, y: %.4f, yaw: 0.0}}' % (i, cx - CHAIN_PITCH * j, cy))
+        if j > 0:
+            links.append('  - {holder: sbot_%d, held: sbot_%d, kind: front_gripper}' % (i, i - 1))
+    with open(path, 'w') as f:
+        f.write('\n'.join(lines + (['links:'] + links if links else [])) + '\n')
+
+
+def drive_chains(robots, k, stats_path):
+    """The driver node (a child process): one random command per chain and simulated second; counts
+    /swarm/graph messages. Writes its counts to `stats_path` when interrupted."""
+    import rospy
+    from sbot_msgs.msg import SwarmGraph, TrackSpeed
+    rospy.init_node('node_bench_driver', disable_signals=True)
+    pubs = [rospy.Publisher('/sbot_%d/cmd_speed' % i, TrackSpeed, queue_size=1) for i in range(robots)]
+    stats = {'graphs': 0, 'first': None, 'last': None, 'components': None, 'moved': 0.0}
+    start = {}
+
+    def on_graph(msg):
+        t = msg.header.stamp.to_sec()
+        stats['graphs'] += 1
+        stats['first'] = t if stats['first'] is None else stats['first']
+        stats['last'] = t
+        stats['components'] = len(set(msg.component))
+        if not start:
+            start.update({name: (p.x, p.y) for name, p in zip(msg.names, msg.positions)})
+        moved = [((p.x - start[name][0]) ** 2 + (p.y - start[name][1]) ** 2) ** 0.5
+                 for name, p in zip(msg.names, msg.positions) if name in start]
+        stats['moved'] = sum(moved) / len(moved) if moved else 0.0
+
+    rospy.Subscriber('/swarm/graph', SwarmGraph, on_graph, queue_size=100)
+    rng = random.Random(1)
+
+    def command(_event):
+        for c in range(0, robots, k):
+            cmd = TrackSpeed(left=rng.randint(-70, 70), right=rng.randint(-70, 70))
+            for i in range(c, min(c + k, robots)):
+                pubs[i].publish(cmd)
+
+    rospy.Timer(rospy.Duration(1.0), command)
+    try:
+        while not rospy.is_shutdown():
+            time.sleep(0.1)
+    except KeyboardInterrupt:
+        pass
+    with open(stats_path, 'w') as f:
+        json.dump(stats, f)
+
+
+def run(robots, seconds, scenario, chains=0):
     port = free_port()
     env = dict(os.environ, ROS_MASTER_URI='http://127.0.0.1:%d' % port)
     devnull = subprocess.DEVNULL
     master = subprocess.Popen(['rosmaster', '--core', '-p', str(port)], env=env, stdout=devnull, stderr=devnull)
     tmp = tempfile.mkdtemp(prefix='node_bench_')
+    stats = None
     try:
         time.sleep(1.0)
         subprocess.check_call(['rosparam', 'set', '/use_sim_time', 'true'], env=env)
-        # Every topic but the raw camera images by default: those are ray-cast in software for every
-        # subscribed robot (~12 ms per frame each). NODE_BENCH_EXCLUDE sets another exclusion regex.
-        exclude = os.environ.get('NODE_BENCH_EXCLUDE', '.*/camera/image_raw.*')
-        recorder = subprocess.Popen(['rosbag', 'record', '-a', '-x', exclude, '-q',
-                                     '-O', os.path.join(tmp, 'b.bag')],
-                                    env=env, stdout=devnull, stderr=devnull, start_new_session=True)
+        if chains:
+            scenario = os.path.join(tmp, 'chains.yaml')
+            chain_scenario(robots, chains, scenario)
+            stats_path = os.path.join(tmp, 'driver.json')
+            recorder = subprocess.Popen([sys.executable, os.path.realpath(__file__), '--_driver', stats_path,
+                                         '--robots', str(robots), '--chains', str(chains)],
+                                        env=env, stdout=devnull, stderr=devnull, start_new_session=True)
+        else:
+            # Every topic but the raw camera images by default: those are ray-cast in software for
+            # every subscribed robot (~12 ms per frame each). NODE_BENCH_EXCLUDE sets another regex.
+            exclude = os.environ.get('NODE_BENCH_EXCLUDE', '.*/camera/image_raw.*')
+            recorder = subprocess.Popen(['rosbag', 'record', '-a', '-x', exclude, '-q',
+                                         '-O', os.path.join(tmp, 'b.bag')],
+                                        env=env, stdout=devnull, stderr=devnull, start_new_session=True)
         time.sleep(1.0)
         log_path = os.path.join(tmp, 'node.log')
         with open(log_path, 'w') as log:
@@ -65,37 +148,75 @@ def run(robots, seconds, scenario):
                 peak = max(peak, peak_rss_mib(node.pid))
                 time.sleep(0.05)
         # `rosbag record` runs the recorder as a child process: interrupt the whole group (SIGINT
-        # closes the bag), or the child outlives the benchmark and loads the next rows.
+        # closes the bag; the driver writes its counts), or the child outlives the benchmark.
         os.killpg(recorder.pid, signal.SIGINT)
         recorder.wait()
+        if chains and os.path.exists(stats_path):
+            with open(stats_path) as f:
+                stats = json.load(f)
         # The node's own summary times the stepping loop (start-up and spawning excluded).
         with open(log_path) as log:
             match = re.search(r'wall time ([0-9.]+) s \(([0-9.]+) s paused\)', log.read())
         wall = float(match.group(1)) - float(match.group(2)) if match else float('nan')
-        return node.returncode, wall, peak
+        return node.returncode, wall, peak, stats
     finally:
         master.terminate()
         master.wait()
         subprocess.call(['rm', '-rf', tmp])
 
 
+def positive_int(text):
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError('expected a whole number >= 1, found %r' % text)
+    return value
+
+
+def robot_counts(text):
+    try:
+        counts = [positive_int(x) for x in text.split(',')]
+    except ValueError:
+        raise argparse.ArgumentTypeError('expected robot counts like 1,10,100, found %r' % text)
+    return counts
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument('--robots', default='1,10,100')
+    parser.add_argument('--robots', type=robot_counts, default=None, help='robot counts (default 1,10,100; 100 with --chains)')
     parser.add_argument('--seconds', type=float, default=20.0)
+    parser.add_argument('--chains', type=positive_int, default=0, help='robots per chain (static front-gripper links)')
+    parser.add_argument('--_driver', help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args._driver:
+        drive_chains(args.robots[0], args.chains, args._driver)
+        return 0
+    counts = args.robots or ([100] if args.chains else [1, 10, 100])
     scenario = os.path.join(rospkg.RosPack().get_path('swarmbot3d'), 'config', 'scenarios', 'bench_flat.yaml')
-    print('node_bench: simulator_node + rosbag record -a (raw camera images excluded), flat arena, idle robots')
+    if args.chains:
+        print('node_bench: simulator_node, chains of %d (static front-gripper links), one random command per chain '
+              'and second, /swarm/graph at 10 Hz, nothing recorded' % args.chains)
+    else:
+        print('node_bench: simulator_node + rosbag record -a (raw camera images excluded), flat arena, idle robots')
     print('%-8s %7s %10s %12s %14s %12s' % ('level', 'robots', 'sim_s', 'RTM', 'wall_ms/step', 'peak_MiB'))
     failures = 0
-    for n in [int(x) for x in args.robots.split(',')]:
-        code, wall, peak = run(n, args.seconds, scenario)
+    for n in counts:
+        code, wall, peak, stats = run(n, args.seconds, scenario, args.chains)
         if code != 0:
             failures += 1
             print('%-8s %7d  simulator_node exited with %d' % ('simple', n, code))
             continue
-        print('%-8s %7d %10.1f %12.1f %14.3f %12.1f' % ('simple', n, args.seconds, args.seconds / wall,
-                                                       1000.0 * wall / (args.seconds / 0.01), peak))
+        line = '%-8s %7d %10.1f %12.1f %14.3f %12.1f' % ('simple', n, args.seconds, args.seconds / wall,
+                                                         1000.0 * wall / (args.seconds / 0.01), peak)
+        if args.chains:
+            if stats and stats['graphs'] > 1:
+                span = stats['last'] - stats['first']
+                line += '   /swarm/graph: %d messages, %.1f Hz of sim time, %d swarm-bots, robots moved %.2f m on average' % (
+                    stats['graphs'], (stats['graphs'] - 1) / span if span > 0 else float('nan'), stats['components'],
+                    stats['moved'])
+            else:
+                failures += 1
+                line += '   /swarm/graph: no messages received'
+        print(line)
         sys.stdout.flush()
     return 1 if failures else 0
 

@@ -1,0 +1,42 @@
+#!/usr/bin/python3
+"""node_bench.py --chains: the simulator node runs robots linked in chains by static front-gripper
+links, the driver moves them, and /swarm/graph reports the chains as swarm-bots at 10 Hz of simulated
+time. Checks what the benchmark line says, not how fast it was (no timing bar in a test)."""
+import os
+import re
+import subprocess
+import unittest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
+TOOL = os.path.join(ROOT, "src", "node_bench.py")
+
+
+def bench(*args):
+    return subprocess.run(["/usr/bin/python3", TOOL] + list(args), capture_output=True, text=True, timeout=240)
+
+
+class NodeBenchChains(unittest.TestCase):
+    def test_ten_robots_in_chains_of_five_are_two_moving_swarm_bots(self):
+        r = bench("--chains", "5", "--robots", "10", "--seconds", "3")
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        line = [l for l in r.stdout.splitlines() if l.startswith("simple")]
+        self.assertEqual(len(line), 1, r.stdout)
+        m = re.search(r"simple\s+10\s+3\.0\s+([0-9.]+) .*/swarm/graph: (\d+) messages, ([0-9.]+) Hz of sim time, "
+                      r"(\d+) swarm-bots, robots moved ([0-9.]+) m", line[0])
+        self.assertIsNotNone(m, line[0])
+        rtm, messages, hz, components, moved = float(m.group(1)), int(m.group(2)), float(m.group(3)), int(m.group(4)), float(m.group(5))
+        self.assertGreater(rtm, 0)
+        self.assertGreaterEqual(messages, 25)      # 10 Hz over 3 s of simulated time
+        self.assertAlmostEqual(hz, 10.0, delta=0.5)
+        self.assertEqual(components, 2)            # two chains of five, each one swarm-bot
+        self.assertGreater(moved, 0.01)            # the driver's commands reached the robots
+
+    def test_a_chain_length_that_is_not_a_positive_whole_number_is_refused(self):
+        for bad in ("0", "x"):
+            r = bench("--chains", bad)
+            self.assertEqual(r.returncode, 2)
+            self.assertIn("--chains", r.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
