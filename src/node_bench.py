@@ -77,6 +77,8 @@ def drive_chains(robots, k, stats_path):
     /swarm/graph messages. Writes its counts to `stats_path` when interrupted."""
     import rospy
     from sbot_msgs.msg import SwarmGraph, TrackSpeed
+    from sbot_msgs.srv import Step
+    from std_srvs.srv import Trigger
     rospy.init_node('node_bench_driver', disable_signals=True)
     pubs = [rospy.Publisher('/sbot_%d/cmd_speed' % i, TrackSpeed, queue_size=1) for i in range(robots)]
     stats = {'graphs': 0, 'first': None, 'last': None, 'components': None, 'moved': 0.0}
@@ -94,7 +96,7 @@ def drive_chains(robots, k, stats_path):
                  for name, p in zip(msg.names, msg.positions) if name in start]
         stats['moved'] = sum(moved) / len(moved) if moved else 0.0
 
-    rospy.Subscriber('/swarm/graph', SwarmGraph, on_graph, queue_size=100)
+    graph = rospy.Subscriber('/swarm/graph', SwarmGraph, on_graph, queue_size=100)
     rng = random.Random(1)
 
     def command(_event):
@@ -103,7 +105,17 @@ def drive_chains(robots, k, stats_path):
             for i in range(c, min(c + k, robots)):
                 pubs[i].publish(cmd)
 
+    # The node starts paused (node_bench passes ~paused): unpause once every command topic and the
+    # graph are connected, or a fast run would be over before the first command arrives.
+    rospy.wait_for_service('/sim/step')
+    rospy.ServiceProxy('/sim/step', Step)(1)  # t = one step: rospy's sim-time timers need a non-zero clock
+    deadline = time.time() + 60
+    while time.time() < deadline and (any(p.get_num_connections() < 1 for p in pubs) or graph.get_num_connections() < 1):
+        time.sleep(0.05)
     rospy.Timer(rospy.Duration(1.0), command)
+    command(None)  # the first command at t = 0
+    rospy.wait_for_service('/sim/unpause')
+    rospy.ServiceProxy('/sim/unpause', Trigger)()
     try:
         while not rospy.is_shutdown():
             time.sleep(0.1)
@@ -141,7 +153,8 @@ def run(robots, seconds, scenario, chains=0):
         log_path = os.path.join(tmp, 'node.log')
         with open(log_path, 'w') as log:
             node = subprocess.Popen(['rosrun', 'sbot_sim', 'simulator_node', '_scenario:=' + scenario,
-                                     '_robots:=%d' % robots, '_duration:=%g' % seconds, '_real_time_factor:=0'],
+                                     '_robots:=%d' % robots, '_duration:=%g' % seconds, '_real_time_factor:=0',
+                                     '_paused:=%s' % ('true' if chains else 'false')],  # the driver unpauses
                                     env=env, stdout=log, stderr=subprocess.STDOUT)
             peak = 0.0
             while node.poll() is None:
