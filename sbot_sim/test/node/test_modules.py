@@ -176,9 +176,15 @@ class Modules(unittest.TestCase):
         self.assertEqual(info.wait(1)[0].width, 640)
 
     def test_slope_flat(self):
+        # On flat ground. The Medium model rests 3-4 deg nose down under quickstep at 20 iterations
+        # (docs/validation/report.md, "Model facts": pitch 3.4 deg; 0.5 deg at 200 iterations), so
+        # its reading may be -4 (a bound of 3 failed a fresh-clone run on 2026-11-25); the Fast model rests level.
         s = rospy.wait_for_message('/sbot_0/slope', Slope, 20)
-        self.assertLessEqual(abs(s.pitch), 3)
+        self.assertLessEqual(abs(s.pitch), 5)
         self.assertLessEqual(abs(s.roll), 3)
+        s = rospy.wait_for_message('/sbot_1/slope', Slope, 20)
+        self.assertLessEqual(abs(s.pitch), 2)
+        self.assertLessEqual(abs(s.roll), 2)
 
 
 if __name__ == '__main__':
