@@ -185,6 +185,16 @@ def positive_int(text):
     return value
 
 
+def positive_seconds(text):
+    try:
+        value = float(text)
+    except ValueError:
+        value = float('nan')
+    if not value > 0 or value == float('inf'):
+        raise argparse.ArgumentTypeError('expected simulated seconds > 0, found %r' % text)
+    return value
+
+
 def robot_counts(text):
     try:
         counts = [positive_int(x) for x in text.split(',')]
@@ -196,7 +206,7 @@ def robot_counts(text):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--robots', type=robot_counts, default=None, help='robot counts (default 1,10,100; 100 with --chains)')
-    parser.add_argument('--seconds', type=float, default=20.0)
+    parser.add_argument('--seconds', type=positive_seconds, default=20.0)
     parser.add_argument('--chains', type=positive_int, default=0, help='robots per chain (static front-gripper links)')
     parser.add_argument('--_driver', help=argparse.SUPPRESS)
     args = parser.parse_args()

@@ -31,11 +31,13 @@ class NodeBenchChains(unittest.TestCase):
         self.assertEqual(components, 2)            # two chains of five, each one swarm-bot
         self.assertGreater(moved, 0.01)            # the driver's commands reached the robots
 
-    def test_a_chain_length_that_is_not_a_positive_whole_number_is_refused(self):
-        for bad in ("0", "x"):
-            r = bench("--chains", bad)
-            self.assertEqual(r.returncode, 2)
-            self.assertIn("--chains", r.stderr)
+    def test_bad_options_are_refused_by_name(self):
+        for option, bad in (("--chains", "0"), ("--chains", "x"), ("--seconds", "-1"), ("--seconds", "nan"),
+                            ("--robots", "10,a")):
+            r = bench(option, bad)
+            self.assertEqual(r.returncode, 2, (option, bad))
+            self.assertIn(option, r.stderr)
+            self.assertIn(repr(bad), r.stderr)
 
 
 if __name__ == "__main__":
