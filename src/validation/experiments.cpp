@@ -64,8 +64,9 @@ int checkEvery(const World& w) { return std::max(1, static_cast<int>(std::lround
 
 bool g_trace = false;  // setTrace
 
-/// One line of the --trace output (every 0.1 s of simulated time): the first robot's base pose and attitude, its driven wheels'
-/// load and the front gripper tip's height (what decides most of the tables' cells).
+/// One line of the --trace output (every 0.1 s of simulated time): the first robot's base pose and
+/// attitude (pitch > 0 nose down, as REP-103), its driven wheels' load and the front gripper tip's
+/// height (what decides most of the tables' cells).
 void traceLine(World& w) {
   const std::vector<Robot*> robots = w.robots();
   if (robots.empty()) return;

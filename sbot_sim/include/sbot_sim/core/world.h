@@ -63,7 +63,7 @@ class World {
     std::uint64_t contacts = 0;  ///< contact joints created (counted whether or not timing is on)
     double total_s() const { return commands_s + collision_s + solver_s + feedback_s; }
   };
-  /// Time the phases of every step from now on (4 clock reads per step, ~1 % of a Fast step);
+  /// Time the phases of every step from now on (5 clock reads per step, ~1-2 % of a Fast step);
   /// resets the profile. Off by default.
   void enableProfile(bool on);
   const StepProfile& profile() const { return profile_; }
