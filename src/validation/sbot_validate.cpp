@@ -185,6 +185,7 @@ std::string findHeightmap() {
 int main(int argc, char** argv) {
   if (!v::studyKnobsOk("sbot_validate")) return 2;
   Options o;
+  bool trace = false;
   sbot_tools::ArgReader args("sbot_validate", argc, argv);
   while (args.more()) {
     const std::string a = args.option();
@@ -193,10 +194,11 @@ int main(int argc, char** argv) {
     else if (a == "--trials") o.trials = args.count(1, 1000);
     else if (a == "--jobs") o.jobs = args.count(1, 64);
     else if (a == "--heightmap") o.heightmap = args.value();
-    else if (a == "--trace") v::setTrace(true);  // with --trial (before it): the robot's state every 0.1 s
+    else if (a == "--trace") trace = true;  // with --trial (before it): the robot's state every 0.1 s
     else if (a == "--trial") {  // --trial KIND LEVEL PARAM: one trial, printed (tuning aid)
       const std::string kind = args.value(), level = args.value();
       const double p = sbot_tools::numberArg(args.tool(), "--trial " + kind + " " + level, args.value(), -1e6, 1e6);
+      v::setTrace(trace);
       Outcome r;
       if (kind == "gap") r = v::gapTrial(level, p, 0);
       else if (kind == "step") r = v::stepTrial(level, p, false, 0);
@@ -219,9 +221,14 @@ int main(int argc, char** argv) {
       for (std::string s; std::getline(ss, s, ',');) o.only.insert(s);
     } else {
       std::fprintf(stderr, "usage: sbot_validate --out DIR [--quick] [--trials N] [--jobs N] [--heightmap PNG]\n"
-                           "                     [--only 4.1,4.2,4.3,4.4,4.5,4.6,fig4.4,compat]\n");
+                           "                     [--only 4.1,4.2,4.3,4.4,4.5,4.6,fig4.4,compat]\n"
+                           "       sbot_validate [--trace] --trial KIND LEVEL PARAM\n");
       return a == "--help" ? 0 : 2;
     }
+  }
+  if (trace) {  // a whole report's trials would interleave their traces from the worker processes
+    std::fprintf(stderr, "sbot_validate: --trace goes with --trial (before it): one trial, traced\n");
+    return 2;
   }
   if (o.quick) { o.trials = std::min(o.trials, 3); o.rough_runs = 4; }
   o.rough_runs = std::max(o.rough_runs, o.quick ? 4 : 12);

@@ -88,6 +88,7 @@ TEST(ToolsCli, TraceShowsTheRobotTippingOntoItsGripper) {
   }
   EXPECT_GT(lines, 20) << o.output;
   EXPECT_GT(max_pitch, 30.0) << o.output;
+  expectRefused("sbot_validate", "--out " + testing::TempDir() + "cli --trace", "--trace goes with --trial");
 }
 
 }  // namespace
