@@ -18,6 +18,7 @@ swarm-bots (connected components) they report.
 """
 import argparse
 import json
+import math
 import os
 import random
 import re
@@ -55,7 +56,7 @@ def chain_scenario(robots, k, path):
     """A walled flat arena with `robots` Simple s-bots in chains of `k` (sbot_<i+1> holds sbot_<i>),
     the chains on a grid of cells as sbot_bench --chains lays them out."""
     chains = (robots + k - 1) // k
-    side = max(1, int(round(chains ** 0.5 + 0.4999)))
+    side = max(1, math.ceil(math.sqrt(chains)))
     dx, dy = CHAIN_PITCH * k + 0.3, 0.35
     arena = max(side * dx, side * dy) + 1.0
     lines = ['name: node_bench_chains', 'seed: 1', 'duration: 0', 'world:', '  step: 0.01', '  terrain:',
@@ -82,7 +83,7 @@ def drive_chains(robots, k, stats_path):
     rospy.init_node('node_bench_driver', disable_signals=True)
     pubs = [rospy.Publisher('/sbot_%d/cmd_speed' % i, TrackSpeed, queue_size=1) for i in range(robots)]
     stats = {'graphs': 0, 'first': None, 'last': None, 'components': None, 'moved': 0.0}
-    start = {}
+    positions = {}  # 'first' and 'last' graph: robot name -> (x, y)
 
     def on_graph(msg):
         t = msg.header.stamp.to_sec()
@@ -90,11 +91,9 @@ def drive_chains(robots, k, stats_path):
         stats['first'] = t if stats['first'] is None else stats['first']
         stats['last'] = t
         stats['components'] = len(set(msg.component))
-        if not start:
-            start.update({name: (p.x, p.y) for name, p in zip(msg.names, msg.positions)})
-        moved = [((p.x - start[name][0]) ** 2 + (p.y - start[name][1]) ** 2) ** 0.5
-                 for name, p in zip(msg.names, msg.positions) if name in start]
-        stats['moved'] = sum(moved) / len(moved) if moved else 0.0
+        xy = {name: (p.x, p.y) for name, p in zip(msg.names, msg.positions)}
+        positions.setdefault('first', xy)
+        positions['last'] = xy
 
     graph = rospy.Subscriber('/swarm/graph', SwarmGraph, on_graph, queue_size=100)
     rng = random.Random(1)
@@ -121,6 +120,10 @@ def drive_chains(robots, k, stats_path):
             time.sleep(0.1)
     except KeyboardInterrupt:
         pass
+    if positions:
+        first, last = positions['first'], positions['last']
+        moved = [math.dist(first[n], last[n]) for n in last if n in first]
+        stats['moved'] = sum(moved) / len(moved) if moved else 0.0
     with open(stats_path, 'w') as f:
         json.dump(stats, f)
 
@@ -139,14 +142,14 @@ def run(robots, seconds, scenario, chains=0):
             scenario = os.path.join(tmp, 'chains.yaml')
             chain_scenario(robots, chains, scenario)
             stats_path = os.path.join(tmp, 'driver.json')
-            recorder = subprocess.Popen([sys.executable, os.path.realpath(__file__), '--_driver', stats_path,
+            listener = subprocess.Popen([sys.executable, os.path.realpath(__file__), '--_driver', stats_path,
                                          '--robots', str(robots), '--chains', str(chains)],
                                         env=env, stdout=devnull, stderr=devnull, start_new_session=True)
         else:
             # Every topic but the raw camera images by default: those are ray-cast in software for
             # every subscribed robot (~12 ms per frame each). NODE_BENCH_EXCLUDE sets another regex.
             exclude = os.environ.get('NODE_BENCH_EXCLUDE', '.*/camera/image_raw.*')
-            recorder = subprocess.Popen(['rosbag', 'record', '-a', '-x', exclude, '-q',
+            listener = subprocess.Popen(['rosbag', 'record', '-a', '-x', exclude, '-q',
                                          '-O', os.path.join(tmp, 'b.bag')],
                                         env=env, stdout=devnull, stderr=devnull, start_new_session=True)
         time.sleep(1.0)
@@ -160,10 +163,11 @@ def run(robots, seconds, scenario, chains=0):
             while node.poll() is None:
                 peak = max(peak, peak_rss_mib(node.pid))
                 time.sleep(0.05)
-        # `rosbag record` runs the recorder as a child process: interrupt the whole group (SIGINT
-        # closes the bag; the driver writes its counts), or the child outlives the benchmark.
-        os.killpg(recorder.pid, signal.SIGINT)
-        recorder.wait()
+        # The listener (`rosbag record`, whose recorder is a child process, or the chain driver):
+        # interrupt the whole group (SIGINT closes the bag; the driver writes its counts), or a child
+        # outlives the benchmark and loads the next rows.
+        os.killpg(listener.pid, signal.SIGINT)
+        listener.wait()
         if chains and os.path.exists(stats_path):
             with open(stats_path) as f:
                 stats = json.load(f)
@@ -190,7 +194,7 @@ def positive_seconds(text):
         value = float(text)
     except ValueError:
         value = float('nan')
-    if not value > 0 or value == float('inf'):
+    if not (value > 0 and math.isfinite(value)):
         raise argparse.ArgumentTypeError('expected simulated seconds > 0, found %r' % text)
     return value
 
