@@ -218,6 +218,10 @@ void Robot::build(const Pose& base_pose) {
   if (!d.turret.joint.empty()) turret_hinge_ = hinge_index_.at(d.turret.joint);
   measureTrackWidth();
   if (d.treels.drive == "body") {
+    // The chassis with its casters stands for the tracks here: its ground contacts carry the
+    // load the drive's traction comes from (applyBodyDrive).
+    for (dGeomID g : geoms_)
+      if (dGeomGetBody(g) == baseBody()) static_cast<GeomInfo*>(dGeomGetData(g))->drive_wheel = true;
     buildBodyDrive();
   } else {
     addReflectedRotorInertia(left_hinges_);
@@ -655,13 +659,12 @@ void Robot::applyRollingResistance(const TrackCommand& cmd) {
 void Robot::applyBodyDrive(const TrackCommand& cmd) {
   // (The wheel hinges stay as built: FMax 0, rolling freely.)
   const TreelsSemantics& tr = description_->treels;
-  // Traction: mu(track, ground) * weight, scaled by how upright the chassis is (no push when toppled).
-  const double mass = description_->totalMass();
-  const Vec3 up = bodyPose(baseBody()).orientation * Vec3::UnitZ();
-  // The wheels are passive supports (frictionless, like casters: friction at the wheel contacts
-  // would tip the light robot over in every turn); the drive's grip is the track material's.
-  const double traction = world_.config().contact.muFor("track", "ground") * mass *
-                          world_.config().gravity * std::max(0.0, up.z());
+  // Traction: mu(track, ground) times the load the chassis and its wheels pressed onto whatever
+  // they touched in the last step (driveWheelLoad): nothing while airborne or lifted by another
+  // robot, m g cos(slope) standing on a slope. The wheels are passive supports (frictionless, like
+  // casters: friction at the wheel contacts would tip the light robot over in every turn); the
+  // drive's grip is the track material's.
+  const double traction = world_.config().contact.muFor("track", "ground") * driveWheelLoad();
   double v = 0, yaw_rate = 0, f_max = 0, t_max = 0;
   if (passive_) {
     f_max = std::min(traction, tr.backdrive_force);  // gear back-drive: the pull needed to move it

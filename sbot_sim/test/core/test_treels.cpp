@@ -418,6 +418,24 @@ TEST(TreelsFast, AccelerationIsTractionLimitedAndTorqueIsRead) {
   EXPECT_NEAR(tl, tr, 10) << "straight: the yaw motor only holds small disturbances";
 }
 
+TEST(TreelsFast, NoPushWhileAirborne) {
+  // The drive's traction is the tracks' load: lifted off the ground (by a hand, another robot's
+  // gripper, over a cliff) the robot must not fly along its heading.
+  World w(fastWorld());
+  Robot& r = w.addRobot(loadLevel("fast"), {0, 0, 0}, "sbot_0");
+  runFor(w, 0.5);
+  Pose lifted = r.basePose();
+  lifted.position.z() += 0.3;  // falls 0.3 m in 1/50 g: 1.75 s
+  r.setBasePose(lifted);
+  w.step();  // the load is measured in a step: the next one knows the robot left the ground
+  r.setSpeed(50, 50);
+  runFor(w, 1.2);
+  EXPECT_LT(r.linearVelocity().head<2>().norm(), 0.001) << "no horizontal speed in free fall";
+  EXPECT_GT(r.basePose().position.z(), 0.05) << "still falling";
+  runFor(w, 4.0);
+  EXPECT_NEAR(r.linearVelocity().x(), 0.14, 0.01) << "drives again once landed";
+}
+
 TEST(TreelsFast, PassiveFastRobotHoldsBelowItsScaledBackDriveForce) {
   World w(fastWorld());
   const RobotDescription& d = loadLevel("fast");

@@ -83,7 +83,8 @@ class Robot {
   /// Normal force the surroundings (ground, obstacles, other robots) exerted on the driven
   /// treels wheels in the last step [N]: the load the tracks can grip with. About the robot's
   /// weight on flat ground; near 0 when it is airborne or hung up on its chassis or casters (the
-  /// validation's Table 4.6 tells "stuck" from "slipping" by it). Fast's body drive does not use it.
+  /// validation's Table 4.6 tells "stuck" from "slipping" by it). Fast's body drive counts its
+  /// chassis and casters too (they stand for its tracks) and takes its traction from this load.
   double driveWheelLoad() const { return drive_wheel_load_; }
   /// Turret angle [rad] relative to the treels.
   double turretAngle() const;
@@ -224,7 +225,8 @@ class Robot {
   // contacts carry ~10 mN, too little for ODE's wheel contacts at 100 ms steps (the robot hops and
   // spins its wheels in place), so the tracks act on the chassis directly: a linear motor holds the
   // forward speed (and no side slip) and an angular motor the yaw rate of an ideal differential
-  // drive, each force-limited by the motors and by traction (mu * weight * up.z).
+  // drive, each force-limited by the motors and by traction (mu times the load the chassis, casters
+  // and wheels carried in the last step: none while airborne).
   dJointID drive_linear_ = nullptr;   ///< LMotor, axes chassis x and y
   dJointID drive_angular_ = nullptr;  ///< AMotor, axis chassis z
   dJointFeedback drive_linear_fb_{}, drive_angular_fb_{};
