@@ -88,6 +88,7 @@ World::~World() {
   if (heightfield_data_) dGeomHeightfieldDataDestroy(heightfield_data_);
   dJointGroupDestroy(contacts_);
   if (query_ray_) dGeomDestroy(query_ray_);
+  if (query_box_) dGeomDestroy(query_box_);
   dSpaceDestroy(static_space_);
   dSpaceDestroy(space_);
   dWorldDestroy(world_);
@@ -381,6 +382,69 @@ RayHit World::castRay(const Vec3& origin, const Vec3& direction, double length, 
   dSpaceCollide2(ray, reinterpret_cast<dGeomID>(space_), &query, &rayCallback);
   dSpaceCollide2(ray, reinterpret_cast<dGeomID>(static_space_), &query, &rayCallback);
   return best;
+}
+
+namespace {
+
+struct BoxQuery {
+  dGeomID box;
+  const Robot* ignore;
+  std::vector<dGeomID>* found;
+};
+
+// Collect the geoms whose bounding boxes meet the query box, descending into robot spaces except
+// the ignored robot's (as rayCallback does).
+void boxCallback(void* data, dGeomID o1, dGeomID o2) {
+  auto& q = *static_cast<BoxQuery*>(data);
+  if (dGeomIsSpace(o1) || dGeomIsSpace(o2)) {
+    const dGeomID sub = dGeomIsSpace(o1) ? o1 : o2;
+    if (q.ignore && sub == reinterpret_cast<dGeomID>(q.ignore->space())) return;
+    dSpaceCollide2(o1, o2, data, &boxCallback);
+    return;
+  }
+  const dGeomID other = o1 == q.box ? o2 : o1;
+  const GeomInfo* gi = infoOf(other);
+  if (gi && q.ignore && gi->robot == q.ignore) return;
+  q.found->push_back(other);
+}
+
+}  // namespace
+
+std::vector<RayHit> World::castRays(const Vec3& origin, const std::vector<Vec3>& directions, double length,
+                                    const Robot* ignore) const {
+  std::vector<RayHit> hits(directions.size());
+  if (directions.empty()) return hits;
+  // One broad-phase search for the box around every ray's segment instead of one per ray: for a
+  // sensor's 5-ray cone that was most of the cost of a ray (ODE's space traversal), and a ray can
+  // only hit a geom whose bounding box meets its segment's, so the hits are castRay's.
+  Vec3 lo = origin, hi = origin;
+  for (const Vec3& d : directions) {
+    const Vec3 end = origin + d.normalized() * length;
+    lo = lo.cwiseMin(end);
+    hi = hi.cwiseMax(end);
+  }
+  constexpr double kMargin = 1e-6;  // [m] keeps the box's sides from vanishing (axis-aligned rays)
+  if (!query_box_) query_box_ = dCreateBox(nullptr, 1, 1, 1);
+  const Vec3 centre = 0.5 * (lo + hi), size = (hi - lo).array() + 2 * kMargin;
+  dGeomBoxSetLengths(query_box_, size.x(), size.y(), size.z());
+  dGeomSetPosition(query_box_, centre.x(), centre.y(), centre.z());
+  ray_candidates_.clear();
+  BoxQuery box{query_box_, ignore, &ray_candidates_};
+  dSpaceCollide2(query_box_, reinterpret_cast<dGeomID>(space_), &box, &boxCallback);
+  dSpaceCollide2(query_box_, reinterpret_cast<dGeomID>(static_space_), &box, &boxCallback);
+  if (ray_candidates_.empty()) {
+    for (RayHit& h : hits) h.distance = length;
+    return hits;
+  }
+  dGeomID ray = queryRay(length);
+  for (std::size_t i = 0; i < directions.size(); ++i) {
+    hits[i].distance = length;
+    const Vec3 d = directions[i].normalized();
+    dGeomRaySet(ray, origin.x(), origin.y(), origin.z(), d.x(), d.y(), d.z());
+    RayQuery query{ignore, &hits[i]};
+    for (dGeomID g : ray_candidates_) rayAgainstGeom(query, ray, g);
+  }
+  return hits;
 }
 
 double World::terrainHeight(double x, double y) const {

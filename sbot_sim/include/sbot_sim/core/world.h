@@ -79,6 +79,10 @@ class World {
   double terrainHeight(double x, double y) const;
   /// Cast a ray; `ignore` (optional) is not hit (a sensor's own robot).
   RayHit castRay(const Vec3& origin, const Vec3& direction, double length, const Robot* ignore) const;
+  /// A bundle of rays from one origin (a sensor's cone): the same hits as castRay per direction,
+  /// but the spaces are searched once, for the box that bounds the whole bundle.
+  std::vector<RayHit> castRays(const Vec3& origin, const std::vector<Vec3>& directions, double length,
+                               const Robot* ignore) const;
 
   void addEffect(EffectPtr effect) { effects_.push_back(std::move(effect)); }
   const std::vector<EffectPtr>& effects() const { return effects_; }
@@ -111,6 +115,8 @@ class World {
   /// One ray geom (in no space) reused by castRay/terrainHeight: creating and destroying a geom per
   /// ray cost ~10 % of a sensor-reading Medium step. Makes a World unsafe to query from two threads.
   mutable dGeomID query_ray_ = nullptr;
+  mutable dGeomID query_box_ = nullptr;  ///< castRays' bounding box, also in no space
+  mutable std::vector<dGeomID> ray_candidates_;  ///< castRays' geoms within that box (reused)
   int solver_iterations_ = 0;
   bool exact_solver_ = false;     ///< config_.solver == "exact"
   void updateSolverIterations();  ///< after a robot came, went or changed level

@@ -48,9 +48,13 @@ BundleHit traceBundle(const World& world, const Pose& sensor, const std::vector<
   BundleHit out;
   double sum = 0;
   double nearest = kInf;
-  for (const Vec3& local : directions) {
-    const Vec3 dir = sensor.orientation * local;
-    const RayHit h = world.castRay(sensor.position, dir, range_max, ignore);
+  std::vector<Vec3> dirs;
+  dirs.reserve(directions.size());
+  for (const Vec3& local : directions) dirs.push_back(sensor.orientation * local);
+  const std::vector<RayHit> hits = world.castRays(sensor.position, dirs, range_max, ignore);
+  for (std::size_t i = 0; i < dirs.size(); ++i) {
+    const Vec3& dir = dirs[i];
+    const RayHit& h = hits[i];
     if (!h.hit) continue;
     const double d = std::max(h.distance, range_min);
     sum += d;
