@@ -53,6 +53,7 @@ struct Options {
 };
 
 const std::vector<std::string> kLevels{"fast", "simple", "medium", "detailed"};
+constexpr int kRtmRepeats = 3;  ///< Table 4.4: runs per RTM figure, the fastest reported
 
 std::string fmt(double v, int prec = 2) {
   std::ostringstream s;
@@ -459,20 +460,31 @@ int main(int argc, char** argv) {
        << "One process, the suite's other worker idle (the seed: dual 3.06 GHz Xeon). Target: 10x the seed. A random "
           "walk (new setSpeed every simulated second); sensors: the whole proximity ring every step, plus "
           "ground and light sensors where the level has them (SensorSuite). The last column is the same "
-          "run without any sensor reads. Machine load average when measured: " << fmt(load[0]) << " on "
+          "run without any sensor reads. Each RTM is the best of " << kRtmRepeats << " runs (another process on the "
+          "machine can only slow a run down). Machine load average when measured: " << fmt(load[0]) << " on "
        << sysconf(_SC_NPROCESSORS_ONLN) << " cores (above ~1, other processes share the CPU and these RTMs are "
           "pessimistic).\n\n"
        << "| level | step | solver iterations | seed RTM | target (10x) | ours RTM | wall ms/step | target met | physics only RTM |\n|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& level : kLevels) {
       const double secs = level == "fast" ? 3000 : (level == "detailed" ? 60 : 300);
-      auto r = v::runParallel(1, 1, [&](int) { return v::rtmTrial(level, o.quick ? secs / 3 : secs); });
-      auto p = v::runParallel(1, 1, [&](int) { return v::rtmTrial(level, o.quick ? secs / 3 : secs, false); });
+      // One run at a time (the trials time themselves), the fastest kept.
+      auto best = [&](bool with_sensors) {
+        v::Outcome fastest{"error"};
+        for (int k = 0; k < kRtmRepeats; ++k) {
+          const v::Outcome run =
+              v::runParallel(1, 1, [&](int) { return v::rtmTrial(level, o.quick ? secs / 3 : secs, with_sensors); })[0];
+          if (k == 0 || run.value > fastest.value) fastest = run;
+        }
+        return fastest;
+      };
+      const v::Outcome r = best(true);
+      const v::Outcome p = best(false);
       const double target = 10 * seed.at(level);
       const int needs = sbot::loadLevel(level).solver_iterations;  // 0: the world default
       const std::string it = needs > 0 ? std::to_string(needs) : std::to_string(sbot::WorldConfig().solver_iterations) + " (default)";
       md << "| " << level << " | " << sbot::loadLevel(level).recommended_step * 1000 << " ms | " << it << " | " << seed.at(level)
-         << " | " << target << " | " << fmt(r[0].value, 0) << " | " << fmt(r[0].value2, 4) << " | "
-         << (r[0].value >= target ? "yes" : "**no**") << " | " << fmt(p[0].value, 0) << " |\n";
+         << " | " << target << " | " << fmt(r.value, 0) << " | " << fmt(r.value2, 4) << " | "
+         << (r.value >= target ? "yes" : "**no**") << " | " << fmt(p.value, 0) << " |\n";
     }
     md << "\n";
     writeProfile(md, o.quick);
