@@ -659,12 +659,15 @@ void Robot::applyRollingResistance(const TrackCommand& cmd) {
 void Robot::applyBodyDrive(const TrackCommand& cmd) {
   // (The wheel hinges stay as built: FMax 0, rolling freely.)
   const TreelsSemantics& tr = description_->treels;
-  // Traction: mu(track, ground) times the load the chassis and its wheels pressed onto whatever
-  // they touched in the last step (driveWheelLoad): nothing while airborne or lifted by another
-  // robot, m g cos(slope) standing on a slope. The wheels are passive supports (frictionless, like
-  // casters: friction at the wheel contacts would tip the light robot over in every turn); the
-  // drive's grip is the track material's.
-  const double traction = world_.config().contact.muFor("track", "ground") * driveWheelLoad();
+  // Traction: mu(track, ground) times the load that pressed the chassis, casters and wheels onto
+  // their support in the last step (driveContactForce along the chassis' up axis): nothing while
+  // airborne or lifted by another robot, m g cos(slope) standing on a slope, and a wall or robot
+  // pushing from the side adds none. The wheels are passive supports (frictionless, like casters:
+  // friction at the wheel contacts would tip the light robot over in every turn); the drive's grip
+  // is the track material's.
+  const Vec3 up = bodyPose(baseBody()).orientation * Vec3::UnitZ();
+  const double traction =
+      world_.config().contact.muFor("track", "ground") * std::max(0.0, driveContactForce().dot(up));
   double v = 0, yaw_rate = 0, f_max = 0, t_max = 0;
   if (passive_) {
     f_max = std::min(traction, tr.backdrive_force);  // gear back-drive: the pull needed to move it

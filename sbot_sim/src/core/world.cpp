@@ -311,10 +311,11 @@ void World::handlePair(dGeomID a, dGeomID b) {
 }
 
 void World::updateDriveWheelLoads() {
-  for (auto& r : robots_) r->setDriveWheelLoad(0);
+  for (auto& r : robots_) r->clearDriveContacts();
   auto add = [](Robot* r, const dVector3 force, double sign, const Vec3& normal) {
-    const double push = sign * Vec3(force[0], force[1], force[2]).dot(normal);
-    if (r && push > 0) r->setDriveWheelLoad(r->driveWheelLoad() + push);
+    const Vec3 f(force[0], force[1], force[2]);
+    const double push = sign * f.dot(normal);
+    if (r && push > 0) r->addDriveContact(push, f);
   };
   for (const WheelContact& w : wheel_contacts_) {
     // The contact normal points from geom 2 into geom 1: body 1 is pushed along it, body 2

@@ -436,6 +436,34 @@ TEST(TreelsFast, NoPushWhileAirborne) {
   EXPECT_NEAR(r.linearVelocity().x(), 0.14, 0.01) << "drives again once landed";
 }
 
+TEST(TreelsFast, TractionComesFromTheLoadNotFromASidePush) {
+  // A Fast robot pressed sideways against a wall: the wall's push shows in the contact force but
+  // not along the chassis' up axis, which is what the drive's traction is taken from.
+  WorldConfig c = fastWorld();
+  c.terrain.type = TerrainConfig::Type::Composite;
+  BoxObstacle wall;
+  wall.name = "wall";
+  wall.center = Vec3(0, 0.0315 + 0.01, 0.02);  // its face where the wheels end (y = 2.05 + 1.1 cm)
+  wall.size = Vec3(0.2, 0.02, 0.04);
+  c.terrain.boxes.push_back(wall);
+  World w(c);
+  Robot& r = w.addRobot(loadLevel("fast"), {0, 0, 0}, "sbot_0");
+  runFor(w, 0.5);
+  const double weight = r.description().totalMass() * w.config().gravity;
+  const Vec3 up = r.basePose().orientation * Vec3::UnitZ();
+  EXPECT_NEAR(r.driveContactForce().dot(up), weight, 0.05 * weight) << "standing: the weight";
+  const double push = 2 * weight;
+  for (int i = 1; i <= 30; ++i) {  // ramped over 1 s, then held 2 s: a jolt would roll the light robot
+    dBodyAddForce(r.baseBody(), 0, push * std::min(1.0, i / 10.0), 0);
+    w.step();
+  }
+  const Vec3 f = r.driveContactForce();
+  EXPECT_LT(f.y(), -0.3 * weight) << "the wall pushes back on the wheel and chassis";
+  EXPECT_GT(r.driveWheelLoad(), 1.3 * weight) << "the wall's push is in the contacts' normal load";
+  EXPECT_NEAR(f.dot(r.basePose().orientation * Vec3::UnitZ()), weight, 0.2 * weight)
+      << "but not in the load along the chassis' up axis";
+}
+
 TEST(TreelsFast, PassiveFastRobotHoldsBelowItsScaledBackDriveForce) {
   World w(fastWorld());
   const RobotDescription& d = loadLevel("fast");

@@ -84,8 +84,12 @@ class Robot {
   /// treels wheels in the last step [N]: the load the tracks can grip with. About the robot's
   /// weight on flat ground; near 0 when it is airborne or hung up on its chassis or casters (the
   /// validation's Table 4.6 tells "stuck" from "slipping" by it). Fast's body drive counts its
-  /// chassis and casters too (they stand for its tracks) and takes its traction from this load.
+  /// chassis and casters too (they stand for its tracks).
   double driveWheelLoad() const { return drive_wheel_load_; }
+  /// The same contacts' total force on the robot [N, world frame]. Fast's body drive takes its
+  /// traction from the part along the chassis' up axis: what presses the tracks onto their
+  /// support, not a wall or robot pushing from the side.
+  const Vec3& driveContactForce() const { return drive_contact_force_; }
   /// Turret angle [rad] relative to the treels.
   double turretAngle() const;
   /// The turret is welded to the treels (WorldConfig::lock_idle_turret: quickstep, turrets whose
@@ -140,7 +144,15 @@ class Robot {
   // ---- used by World -----------------------------------------------------------------------------
   void applyCommands(double dt, const std::vector<EffectPtr>& effects);
   void readFeedback(double dt);
-  void setDriveWheelLoad(double newtons) { drive_wheel_load_ = newtons; }
+  void clearDriveContacts() {
+    drive_wheel_load_ = 0;
+    drive_contact_force_ = Vec3::Zero();
+  }
+  /// One contact on a drive geom: its push along the contact normal [N] and its force vector [N].
+  void addDriveContact(double push, const Vec3& force) {
+    drive_wheel_load_ += push;
+    drive_contact_force_ += force;
+  }
   dBodyID baseBody() const;
   dSpaceID space() const { return space_; }
   const std::vector<dBodyID>& bodies() const { return bodies_; }
@@ -217,6 +229,7 @@ class Robot {
   bool wheels_apart_ = false;            ///< the model's driven wheels give the track width
 
   double drive_wheel_load_ = 0;          ///< [N] see driveWheelLoad()
+  Vec3 drive_contact_force_ = Vec3::Zero();  ///< [N] see driveContactForce()
   double req_left_ = 0, req_right_ = 0;  ///< requested track speeds [m/s]
   double turret_target_ = 0;             ///< [rad]
   bool passive_ = false;
@@ -225,8 +238,8 @@ class Robot {
   // contacts carry ~10 mN, too little for ODE's wheel contacts at 100 ms steps (the robot hops and
   // spins its wheels in place), so the tracks act on the chassis directly: a linear motor holds the
   // forward speed (and no side slip) and an angular motor the yaw rate of an ideal differential
-  // drive, each force-limited by the motors and by traction (mu times the load the chassis, casters
-  // and wheels carried in the last step: none while airborne).
+  // drive, each force-limited by the motors and by traction (mu times the load that pressed the
+  // chassis, casters and wheels onto their support in the last step: none while airborne).
   dJointID drive_linear_ = nullptr;   ///< LMotor, axes chassis x and y
   dJointID drive_angular_ = nullptr;  ///< AMotor, axis chassis z
   dJointFeedback drive_linear_fb_{}, drive_angular_fb_{};
