@@ -349,15 +349,18 @@ void rayAgainstGeom(RayQuery& q, dGeomID ray, dGeomID other) {
   b.robot = gi ? gi->robot : nullptr;
 }
 
+// The query walks of castRay and castRays: when (o1, o2) involves a robot's space, descend into it
+// with `callback` unless it is the ignored robot's (skips its ~20 geoms at once) and return true.
+bool descendIntoSpace(void* data, dGeomID o1, dGeomID o2, const Robot* ignore, dNearCallback* callback) {
+  if (!dGeomIsSpace(o1) && !dGeomIsSpace(o2)) return false;
+  const dGeomID sub = dGeomIsSpace(o1) ? o1 : o2;
+  if (!ignore || sub != reinterpret_cast<dGeomID>(ignore->space())) dSpaceCollide2(o1, o2, data, callback);
+  return true;
+}
+
 void rayCallback(void* data, dGeomID o1, dGeomID o2) {
   auto& q = *static_cast<RayQuery*>(data);
-  if (dGeomIsSpace(o1) || dGeomIsSpace(o2)) {
-    // Descend into a robot's space, unless it is the ignored robot's (skips its ~20 geoms at once).
-    const dGeomID sub = dGeomIsSpace(o1) ? o1 : o2;
-    if (q.ignore && sub == reinterpret_cast<dGeomID>(q.ignore->space())) return;
-    dSpaceCollide2(o1, o2, data, &rayCallback);
-    return;
-  }
+  if (descendIntoSpace(data, o1, o2, q.ignore, &rayCallback)) return;
   const bool first_is_ray = dGeomGetClass(o1) == dRayClass;
   rayAgainstGeom(q, first_is_ray ? o1 : o2, first_is_ray ? o2 : o1);
 }
@@ -393,16 +396,10 @@ struct BoxQuery {
   std::vector<dGeomID>* found;
 };
 
-// Collect the geoms whose bounding boxes meet the query box, descending into robot spaces except
-// the ignored robot's (as rayCallback does).
+// Collect the geoms whose bounding boxes meet the query box.
 void boxCallback(void* data, dGeomID o1, dGeomID o2) {
   auto& q = *static_cast<BoxQuery*>(data);
-  if (dGeomIsSpace(o1) || dGeomIsSpace(o2)) {
-    const dGeomID sub = dGeomIsSpace(o1) ? o1 : o2;
-    if (q.ignore && sub == reinterpret_cast<dGeomID>(q.ignore->space())) return;
-    dSpaceCollide2(o1, o2, data, &boxCallback);
-    return;
-  }
+  if (descendIntoSpace(data, o1, o2, q.ignore, &boxCallback)) return;
   const dGeomID other = o1 == q.box ? o2 : o1;
   const GeomInfo* gi = infoOf(other);
   if (gi && q.ignore && gi->robot == q.ignore) return;
