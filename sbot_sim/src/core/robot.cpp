@@ -258,14 +258,18 @@ void Robot::buildBodyDrive() {
   drive_linear_ = dJointCreateLMotor(world_.odeWorld(), nullptr);
   dJointAttach(drive_linear_, chassis, nullptr);
   dJointSetLMotorNumAxes(drive_linear_, 2);
-  dJointSetLMotorAxis(drive_linear_, 0, 1, 1, 0, 0);  // rel 1: axes fixed in the chassis
-  dJointSetLMotorAxis(drive_linear_, 1, 1, 0, 1, 0);
+  // rel 1: the axes stay fixed in the chassis, but ODE takes them in world coordinates, as the
+  // chassis lies now (given as (1, 0, 0), a robot spawned facing +y drove sideways along +x).
+  const Quat q = bodyPose(chassis).orientation;
+  const Vec3 forward = q * Vec3::UnitX(), left = q * Vec3::UnitY(), up = q * Vec3::UnitZ();
+  dJointSetLMotorAxis(drive_linear_, 0, 1, forward.x(), forward.y(), forward.z());
+  dJointSetLMotorAxis(drive_linear_, 1, 1, left.x(), left.y(), left.z());
   dJointSetFeedback(drive_linear_, &drive_linear_fb_);
   drive_angular_ = dJointCreateAMotor(world_.odeWorld(), nullptr);
   dJointAttach(drive_angular_, chassis, nullptr);
   dJointSetAMotorMode(drive_angular_, dAMotorUser);
   dJointSetAMotorNumAxes(drive_angular_, 1);
-  dJointSetAMotorAxis(drive_angular_, 0, 1, 0, 0, 1);
+  dJointSetAMotorAxis(drive_angular_, 0, 1, up.x(), up.y(), up.z());
   dJointSetFeedback(drive_angular_, &drive_angular_fb_);
   dJointSetLMotorParam(drive_linear_, dParamFMax, 0);  // until the first applyCommands
   dJointSetAMotorParam(drive_angular_, dParamFMax, 0);

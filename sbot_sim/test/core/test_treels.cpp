@@ -385,6 +385,23 @@ TEST(TreelsFast, SameSteadySpeedAsTheOtherLevels) {
   EXPECT_NEAR(rr, 50, 1);
 }
 
+TEST(TreelsFast, DrivesAlongItsHeadingWhateverItsSpawnYaw) {
+  // The drive's axes are the chassis' own: a robot spawned facing any way drives where it faces.
+  for (const double yaw : {0.0, 1.6, -2.5, 3.0}) {
+    World w(fastWorld());
+    Robot& r = w.addRobot(loadLevel("fast"), {0.3, -0.2, yaw}, "sbot_0");
+    r.setSpeed(50, 50);
+    runFor(w, 2.0);
+    const Vec3 p0 = r.basePose().position;
+    runFor(w, 2.0);
+    const Vec3 moved = r.basePose().position - p0;
+    const Vec3 heading = r.basePose().orientation * Vec3::UnitX();
+    EXPECT_NEAR(moved.head<2>().norm() / 2.0, 0.140, 0.140 * 0.03) << "yaw " << yaw;
+    EXPECT_GT(moved.head<2>().normalized().dot(heading.head<2>().normalized()), 0.999) << "yaw " << yaw;
+    EXPECT_NEAR(wrapAngle(r.basePose().yaw() - yaw), 0.0, 0.02) << "yaw " << yaw;
+  }
+}
+
 TEST(TreelsFast, SpinsAtTheDifferentialDriveRate) {
   World w(fastWorld());
   Robot& r = w.addRobot(loadLevel("fast"), {0, 0, 0}, "sbot_0");
