@@ -385,24 +385,38 @@ Outcome downhillTrial(const std::string& level, double angle_rad, int trial) {
 
 // ---- Figure 4.4: rough terrain ------------------------------------------------------------------
 
-Outcome roughTrial(const std::string& level, double hr_mm, int trial, const std::string& heightmap_png) {
+Outcome roughTrial(const std::string& level, double hr_cm, int trial, const std::string& heightmap_png) {
   const RobotDescription& d = loadLevel(level);
   const double s = lengthScale(level);
-  Jitter j("rough" + level, hr_mm, trial);
+  Jitter j("rough" + level, hr_cm, trial);
   WorldConfig c = configFor(d, 6000 + trial);
   c.terrain.type = TerrainConfig::Type::Rough;
   c.terrain.heightmap_image = heightmap_png;
   c.terrain.heightmap_seed = 7;
   c.terrain.size_x = c.terrain.size_y = 5.0 * s;  // 4.2.2: the Fast model's terrain is halved
-  c.terrain.height_range = hr_mm / 1000.0 * s;
+  // HR in cm: the seed's simulator worked in CGS units (Tables 2.2-2.13: cm, dyne, dyne cm), and
+  // its labels (HR 1 "almost flat" ... 32 "very rough") fit centimetres: on the default image HR 32 cm
+  // has slopes of 10 deg on average and up to 40, HR 32 mm nothing over 5 deg (until 2026-11-25 HR
+  // was read in mm, and every level kept its course at every HR once no run drove off the map).
+  c.terrain.height_range = hr_cm / 100.0 * s;
   World w(c);
-  Robot& r = spawn(w, d, {j.uniform(-1.5, 1.5) * s, j.uniform(-1.5, 1.5) * s, j.uniform(-M_PI, M_PI)});
+  // A random heading, then a random start from which the whole ideal path (1.52 m, the same for the
+  // half-size Fast on its halved terrain) stays 15 cm inside the height field: there is no ground
+  // beyond its edge (before 2026-11-25 starts were drawn from +-1.5 m, and some runs drove off it).
+  constexpr double kPath = 0.1524 * 10.0, kEdgeMargin = 0.15;  // [m]
+  const double yaw = j.uniform(-M_PI, M_PI);
+  const double inner = 0.5 * c.terrain.size_x - kEdgeMargin;
+  auto start = [&](double along) {  // along: the path's extent on this axis [m]
+    return j.uniform(-inner - std::min(0.0, along), inner - std::max(0.0, along));
+  };
+  const double x0 = start(kPath * std::cos(yaw)), y0 = start(kPath * std::sin(yaw));
+  Robot& r = spawn(w, d, {x0, y0, yaw});
   r.setSpeed(0, 0);
   w.stepN(static_cast<int>(1.0 / c.step));
   const Vec3 p0 = r.basePose().position;
   const double h0 = headingOf(r);
   r.setTrackSpeeds(0.1524, 0.1524);  // 4.2.2: "medium speed (15.24 cm/s)"
-  w.stepN(static_cast<int>(std::lround(10.0 / c.step)));
+  runFor(w, 10.0, [] { return false; });
   const Vec3 p1 = r.basePose().position;
   Outcome o{"ok"};
   o.value = (p1 - p0).dot(Vec3(std::cos(h0), std::sin(h0), 0));

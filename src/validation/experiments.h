@@ -68,9 +68,9 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial);
 /// 4.2.4 downhill: drive from a plateau down a ramp of `angle_rad`. Labels: pass, topple, stuck.
 Outcome downhillTrial(const std::string& level, double angle_rad, int trial);
 
-/// Figure 4.4: random pose and heading on rough terrain of height range `hr_mm`, 10 s at
+/// Figure 4.4: random pose and heading on rough terrain of height range `hr_cm` [cm], 10 s at
 /// 15.24 cm/s; value = travelled distance projected on the initial heading [m].
-Outcome roughTrial(const std::string& level, double hr_mm, int trial, const std::string& heightmap_png);
+Outcome roughTrial(const std::string& level, double hr_cm, int trial, const std::string& heightmap_png);
 
 /// Table 4.4: real-time multiplier of one s-bot on flat ground with its level's sensors read every
 /// step, over `sim_seconds`. value = RTM, value2 = wall ms per step.

@@ -10,7 +10,7 @@
 //   sbot_validate [--trace] --trial KIND LEVEL PARAM    one trial, printed (tuning aid); --trace
 //                                                        prints the robot's state every 0.1 s
 // KIND: gap, step, stepb, slope, slopeb, uphill, downhill, rough, rtm (PARAM: m, m, m, deg, deg,
-// rad, rad, HR in mm, simulated s).
+// rad, rad, HR in cm, simulated s).
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -114,7 +114,7 @@ void plotFig44(const std::string& path, const std::vector<double>& hrs,
   }
   for (std::size_t i = 0; i < hrs.size(); ++i)
     cv::putText(img, fmt(hrs[i], 0), cv::Point(X(i) - 8, H - B + 22), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1);
-  cv::putText(img, "height range HR [mm]", cv::Point(W / 2 - 120, H - 20), cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(0, 0, 0), 1);
+  cv::putText(img, "height range HR [cm]", cv::Point(W / 2 - 120, H - 20), cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(0, 0, 0), 1);
   cv::putText(img, "Fig. 4.4: distance projected on the initial heading after 10 s at 15.24 cm/s [m]",
               cv::Point(L - 60, 30), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1);
   const std::map<std::string, cv::Scalar> colour{{"fast", cv::Scalar(40, 160, 40)}, {"simple", cv::Scalar(200, 120, 0)},
@@ -144,8 +144,8 @@ void plotFig44(const std::string& path, const std::vector<double>& hrs,
     cv::putText(img, level, cv::Point(W - R + 58, T + 25 + 25 * li), cv::FONT_HERSHEY_SIMPLEX, 0.5, col, 1);
     ++li;
   }
-  cv::putText(img, "dots: mean; bars: min-max", cv::Point(W - R + 10, T + 140), cv::FONT_HERSHEY_SIMPLEX, 0.4,
-              cv::Scalar(0, 0, 0), 1);
+  cv::putText(img, "dots: mean", cv::Point(W - R + 20, T + 140), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0), 1);
+  cv::putText(img, "bars: min-max", cv::Point(W - R + 20, T + 158), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0), 1);
   cv::imwrite(path, img);
 }
 
@@ -513,9 +513,12 @@ int main(int argc, char** argv) {
     });
     std::map<std::string, std::vector<std::vector<double>>> data;
     md << "## Figure 4.4 - straight motion on rough terrain\n\n"
-       << "Random pose and heading on a 5 x 5 m height field (Fast: 2.5 x 2.5 m and half the height range, "
+       << "Random heading, and a random start from which the ideal path stays 15 cm inside the height field, "
+          "on a 5 x 5 m height field (Fast: 2.5 x 2.5 m and half the height range, "
           "as the seed halves its terrain) from `" << o.heightmap << "`, 10 s at 15.24 cm/s; distance projected "
-          "on the initial heading (ideal 1.52 m). " << runs << " runs per point.\n\n"
+          "on the initial heading (ideal 1.52 m). HR is the terrain's height range in cm (the seed's simulator "
+          "worked in CGS units: its tables give lengths in cm, forces in dyne; HR 1 'almost flat' to 32 'very "
+          "rough', 4.2.2). " << runs << " runs per point.\n\n"
        << "![Figure 4.4](fig4_4.png)\n\n| level | HR 1 | HR 2 | HR 4 | HR 8 | HR 16 | HR 32 |\n|---|---|---|---|---|---|---|\n";
     for (std::size_t l = 0; l < kLevels.size(); ++l) {
       md << "| " << kLevels[l];

@@ -18,7 +18,7 @@ const std::string kScenarios = std::string(SWARMBOT3D_SOURCE_DIR) + "/config/sce
 TEST(TerrainScenarios, RoughTerrainRobotRestsOnHeightField) {
   Scenario s = loadScenario(kScenarios + "rough_terrain.yaml");
   ASSERT_EQ(s.world.terrain.type, TerrainConfig::Type::Rough);
-  // A much higher range than the scenario's 8 mm so that "on the height field" differs clearly
+  // A higher range than the scenario's 8 cm so that "on the height field" differs clearly
   // from "on a plane at z = 0".
   s.world.terrain.height_range = 0.20;
   const HeightMap map = makeHeightMap(s.world.terrain);

@@ -55,7 +55,7 @@ struct TerrainConfig {
   std::string heightmap_image;          ///< path; empty = generated fractal noise from `seed`
   int resolution = 128;                 ///< samples per side when generated
   double size_x = 5.0, size_y = 5.0;    ///< [m]
-  double height_range = 0.0;            ///< peak-to-peak height [m] (HR of Fig. 4.4 in mm / 1000)
+  double height_range = 0.0;            ///< peak-to-peak height [m] (HR of Fig. 4.4 in cm / 100)
   std::uint64_t heightmap_seed = 1;
 };
 
