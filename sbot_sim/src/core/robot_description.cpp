@@ -360,6 +360,17 @@ const std::vector<std::string>& modelLevels() {
   return levels;
 }
 
+std::string gravityProblem(const RobotDescription& d, double world_gravity) {
+  constexpr double kEarth = 9.81, kTolerance = 0.01;  // [m/s^2], relative
+  const bool scaled = std::abs(d.gravity - kEarth) > kTolerance * kEarth;
+  if (!scaled || std::abs(world_gravity - d.gravity) <= kTolerance * d.gravity) return "";
+  std::ostringstream msg;
+  msg << "level " << d.level << " is scaled for a gravity of " << d.gravity << " m/s^2 (" << d.sidecar_path
+      << "), this world has " << world_gravity << " m/s^2: set the world's gravity to " << d.gravity
+      << " (and its step to " << d.recommended_step << " s) and give it no full-size robots";
+  return msg.str();
+}
+
 const RobotDescription& loadLevel(const std::string& level) {
   static std::mutex mutex;
   static std::map<std::string, std::unique_ptr<RobotDescription>> cache;

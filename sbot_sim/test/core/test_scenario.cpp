@@ -99,6 +99,21 @@ TEST(Scenario, RefusesValuesThatWouldMisbehaveLater) {
   }
 }
 
+// The Fast level is scaled for 1/50 g (seed 3.1): a scenario must give it that gravity, and not put
+// it beside full-size robots, which would live in 1/50 g too; the full-size levels take any gravity.
+TEST(Scenario, FastNeedsItsGravityAndRunsAlone) {
+  const std::string earth = errorOf("robots: [{name: a, level: fast}]");
+  EXPECT_NE(earth.find("level fast is scaled for a gravity of 0.1962 m/s^2"), std::string::npos) << earth;
+  EXPECT_NE(earth.find("this world has 9.81 m/s^2"), std::string::npos) << earth;
+  const std::string mixed = errorOf("world: {gravity: 0.1962, step: 0.1}\nrobots: [{name: a, level: fast}, {name: b, level: simple}]");
+  EXPECT_NE(mixed.find("cannot share a world with full-size robots (simple)"), std::string::npos) << mixed;
+  EXPECT_EQ(parseScenario("world: {gravity: 0.1962, step: 0.1}\nswarm: {count: 3, level: fast}", "ok.yaml").robots.size(), 3u);
+  EXPECT_EQ(parseScenario("world: {gravity: 1.62}\nrobots: [{level: detailed}]", "moon.yaml").robots.size(), 1u);
+  EXPECT_EQ(gravityProblem(loadLevel("fast"), 0.1962), "");
+  EXPECT_NE(gravityProblem(loadLevel("fast"), 9.81), "");
+  EXPECT_EQ(gravityProblem(loadLevel("medium"), 0.1962), "") << "full-size levels take any gravity";
+}
+
 // The same rule guards the other way robots enter a world (the node's /sim/spawn, tools).
 TEST(Scenario, TheWorldRefusesRobotNamesRosCannotUse) {
   World w(WorldConfig{});

@@ -99,6 +99,9 @@ class TestSwarm(unittest.TestCase):
         self.assertFalse(res.success)
         res = self.spawn('sbot_9', 'simple', float('nan'), 1.0, 0.0)
         self.assertFalse(res.success)
+        res = self.spawn('sbot_9', 'fast', 1.0, 1.0, 0.0)  # scaled for 1/50 g, this world has 9.81
+        self.assertFalse(res.success)
+        self.assertIn('scaled for a gravity of 0.1962', res.message)
         for name in ('', '9lives', 'sbot-9', 'sbot 9', 'a/b'):  # ROS could not advertise its topics
             res = self.spawn(name, 'simple', 1.0, 1.0, 0.0)
             self.assertFalse(res.success, name)
