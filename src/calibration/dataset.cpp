@@ -436,6 +436,12 @@ Dataset loadDataset(const std::string& path_in) {
       YAML::Node where = w;
       throw DatasetError(f, where.Mark().line + 1, where.Mark().column + 1, "", e.what());
     }
+    ds.world_sets_step = static_cast<bool>(w["step"]);
+    ds.world_sets_gravity = static_cast<bool>(w["gravity"]);
+    if (ds.world_sets_gravity) {
+      const std::string problem = gravityProblem(loadLevel(ds.robot), ds.world.gravity);
+      if (!problem.empty()) fail(f, w["gravity"], "world.gravity", problem);
+    }
     for (const auto& b : ds.world.terrain.boxes)
       if (!surfaces.count(b.surface)) fail(f, w["terrain"], "world.terrain.boxes", "unknown surface '" + b.surface + "'");
     if (const YAML::Node obs = w["obstacles"]) {
@@ -633,6 +639,8 @@ void writeDataset(const Dataset& ds, const std::string& dir) {
   if (!ds.description.empty()) e << YAML::Key << "description" << YAML::Value << ds.description;
   e << YAML::Key << "robot" << YAML::Value << ds.robot;
   e << YAML::Key << "world" << YAML::Value << YAML::BeginMap;
+  if (ds.world_sets_step) e << YAML::Key << "step" << YAML::Value << ds.world.step;
+  if (ds.world_sets_gravity) e << YAML::Key << "gravity" << YAML::Value << ds.world.gravity;
   if (ds.world.solver != "quickstep") e << YAML::Key << "solver" << YAML::Value << ds.world.solver;
   e << YAML::Key << "terrain" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "type" << YAML::Value
     << "plane" << YAML::EndMap;

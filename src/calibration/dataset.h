@@ -99,6 +99,9 @@ struct Dataset {
   std::string description;
   std::string robot = "medium";
   WorldConfig world;         ///< terrain including the obstacles (as boxes with their surface labels)
+  /// world.step / world.gravity written in the dataset: replays use them; otherwise the model
+  /// level's recommended step and gravity (Fast: 0.1 s, 1/50 g).
+  bool world_sets_step = false, world_sets_gravity = false;
   std::vector<Lamp> lamps;
   double ambient_light = 0;
   NoiseModel noise;

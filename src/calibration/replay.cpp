@@ -472,8 +472,8 @@ RunPrediction replayRun(const Dataset& ds, const Run& run, const ModelSpec& mode
   WorkerPool::count();
   const RobotDescription& d = loadLevel(model.level.empty() ? ds.robot : model.level);
   WorldConfig wc = opt.world_override ? *opt.world_override : ds.world;
-  wc.step = d.recommended_step;
-  wc.gravity = d.gravity;
+  if (!ds.world_sets_step) wc.step = d.recommended_step;
+  if (!ds.world_sets_gravity) wc.gravity = d.gravity;
   PerWorldThreading threading;
   World world(wc);
   threading.attach(world);

@@ -163,6 +163,31 @@ TEST(Dataset, UnknownSurfaceNamesTheYamlLine) {
   EXPECT_NO_THROW(loadDataset(d));
 }
 
+TEST(Dataset, WorldGravityAndStepAreKeptOrRefused) {
+  // Written: used by the replays (and written back); absent: the level's own (Fast: 1/50 g).
+  std::string yaml = kYaml;
+  yaml.replace(yaml.find("world:\n"), 7, "world:\n  gravity: 1.62\n  step: 0.005\n");
+  const Dataset moon = loadDataset(makeDataset("moon", "t,cmd_left,cmd_right,x\n0,1,1,0\n", yaml));
+  EXPECT_TRUE(moon.world_sets_gravity);
+  EXPECT_TRUE(moon.world_sets_step);
+  EXPECT_DOUBLE_EQ(moon.world.gravity, 1.62);
+  const std::string copy = tempDir("moon_copy");
+  writeDataset(moon, copy);
+  const Dataset again = loadDataset(copy);
+  EXPECT_TRUE(again.world_sets_gravity);
+  EXPECT_DOUBLE_EQ(again.world.gravity, 1.62);
+  EXPECT_DOUBLE_EQ(again.world.step, 0.005);
+  const Dataset plain = loadDataset(makeDataset("plain", "t,cmd_left,cmd_right,x\n0,1,1,0\n"));
+  EXPECT_FALSE(plain.world_sets_gravity);
+  EXPECT_FALSE(plain.world_sets_step);
+  // The Fast level is scaled for 1/50 g: a dataset may not put it under 9.81.
+  std::string fast = kYaml;
+  fast.replace(fast.find("robot: simple"), 13, "robot: fast");
+  fast.replace(fast.find("world:\n"), 7, "world:\n  gravity: 9.81\n");
+  const DatasetError e = errorOf(makeDataset("fast_earth", "t,cmd_left,cmd_right,x\n0,1,1,0\n", fast));
+  EXPECT_NE(std::string(e.what()).find("level fast is scaled for a gravity of 0.1962"), std::string::npos) << e.what();
+}
+
 TEST(Dataset, BadYaml) {
   std::string yaml = kYaml;
   yaml.replace(yaml.find("sbot-dataset/1"), 14, "sbot-dataset/7");
