@@ -298,15 +298,27 @@ ProximitySensors::Raw ProximitySensors::raw(int sensor) const {
 }
 
 ProximitySensors::Raw ProximitySensors::rawLut(int sensor) const {
-  const Pose pose = robot_.linkPose(links_[sensor]);
-  const Pose inv = pose.inverse();
   const double reach = lut_->gaps.back();
+  // A first cull on the base bodies' centres, before any link frame or turret size is looked up (by
+  // name: that was most of a lone Simple robot's sensing time). Each robot's sensors and turret rim
+  // lie within kRobotBound of its base body's centre, so a robot culled here is culled below too.
+  constexpr double kRobotBound = 0.15;  // [m] > a 5.7 cm turret radius plus the body's offset from the axis
+  const dReal* me = dBodyGetPosition(robot_.baseBody());
+  bool pose_known = false;
+  Pose pose, inv;
   double best = 0;
   for (Robot* other : world_.robots()) {
     if (other == &robot_) continue;
-    const Vec3 axis = other->hasLink("turret") ? other->linkPose("turret").position : other->basePose().position;
+    const dReal* it = dBodyGetPosition(other->baseBody());
+    if (std::hypot(it[0] - me[0], it[1] - me[1]) - 2 * kRobotBound > reach) continue;
     const double radius = turretRadius(other->description());
-    if ((axis - pose.position).head<2>().norm() - radius > reach) continue;  // cheap cull
+    if (!pose_known) {
+      pose = robot_.linkPose(links_[sensor]);
+      inv = pose.inverse();
+      pose_known = true;
+    }
+    const Vec3 axis = other->hasLink("turret") ? other->linkPose("turret").position : other->basePose().position;
+    if ((axis - pose.position).head<2>().norm() - radius > reach) continue;  // the sensor's own cull
     const Vec3 local = inv.transform(axis);
     const double gap = std::hypot(local.x(), local.y()) - radius;
     const double bearing = std::atan2(local.y(), local.x());
