@@ -128,23 +128,6 @@ class Fields {
   const std::string& file_;
 };
 
-// The Fast level is scaled for 1/50 g (seed 3.1, 4.2.4: "tested separately and alone"): refuse it
-// under another gravity, and beside full-size robots, which would then live in 1/50 g.
-void checkGravityOfLevels(const Scenario& s, const std::string& file) {
-  std::string scaled, full_size;
-  for (std::size_t i = 0; i < s.robots.size(); ++i) {
-    const RobotDescription& d = loadLevel(s.robots[i].level);
-    const std::string problem = gravityProblem(d, s.world.gravity);
-    if (!problem.empty()) throw ConfigError(file, "robots (" + s.robots[i].name + ")", problem);
-    const bool bound_to_its_gravity = !gravityProblem(d, 9.81).empty();  // not usable on Earth: scaled
-    (bound_to_its_gravity ? scaled : full_size) = d.level;
-  }
-  if (!scaled.empty() && !full_size.empty())
-    throw ConfigError(file, "robots", "level " + scaled + " is scaled for " + std::to_string(loadLevel(scaled).gravity) +
-                                          " m/s^2 and cannot share a world with full-size robots (" + full_size +
-                                          "); the seed runs it alone (4.2.4)");
-}
-
 std::string checkLevel(const std::string& level, const std::string& file, const std::string& field) {
   for (const auto& l : modelLevels())
     if (l == level) return level;
@@ -250,6 +233,23 @@ void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
 }
 
 }  // namespace
+
+// The Fast level is scaled for 1/50 g (seed 3.1, 4.2.4: "tested separately and alone"): refuse it
+// under another gravity, and beside full-size robots, which would then live in 1/50 g.
+void checkGravityOfLevels(const Scenario& s, const std::string& file) {
+  std::string scaled, full_size;
+  for (std::size_t i = 0; i < s.robots.size(); ++i) {
+    const RobotDescription& d = loadLevel(s.robots[i].level);
+    const std::string problem = gravityProblem(d, s.world.gravity);
+    if (!problem.empty()) throw ConfigError(file, "robots (" + s.robots[i].name + ")", problem);
+    const bool bound_to_its_gravity = !gravityProblem(d, 9.81).empty();  // not usable on Earth: scaled
+    (bound_to_its_gravity ? scaled : full_size) = d.level;
+  }
+  if (!scaled.empty() && !full_size.empty())
+    throw ConfigError(file, "robots", "level " + scaled + " is scaled for " + std::to_string(loadLevel(scaled).gravity) +
+                                          " m/s^2 and cannot share a world with full-size robots (" + full_size +
+                                          "); the seed runs it alone (4.2.4)");
+}
 
 Scenario parseScenario(const std::string& yaml_text, const std::string& file, int robot_count) {
   if (robot_count > kMaxRobots)

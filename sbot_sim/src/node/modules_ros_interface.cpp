@@ -113,7 +113,8 @@ RobotModulesRos::RobotModulesRos(ros::NodeHandle nh, ros::NodeHandle pnh, const 
   camera_params_.internal_width = std::max(8, camera_params_.width / std::max(1, scale));
   camera_params_.internal_height = std::max(8, camera_params_.height / std::max(1, scale));
   image_transport::ImageTransport it(nh_);
-  camera_pub_ = it.advertiseCamera("camera/image_raw", 1);
+  camera_pub_ = it.advertise("camera/image_raw", 1);
+  camera_info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("camera/camera_info", 1);
   pubs_["markers"] = adv(Tag<visualization_msgs::MarkerArray>(), "sensor_markers", "markers", 2, false);
   pubs_["available"] = nh_.advertise<sbot_msgs::SensorsAvailable>("sensors_available", 1, /*latch=*/true);
   leds_sub_ = nh_.subscribe("leds", 10, &RobotModulesRos::onLeds, this, ros::TransportHints().tcpNoDelay());
@@ -390,7 +391,7 @@ void RobotModulesRos::update(double dt, double sim_time) {
     if (sim_time + 1e-9 >= r.next) {
       r.next += 1.0 / r.hz;
       if (r.next <= sim_time) r.next = sim_time + 1.0 / r.hz;
-      if (camera_pub_.getNumSubscribers() > 0) publishRawCamera(stamp);
+      if (camera_pub_.getNumSubscribers() > 0 || camera_info_pub_.getNumSubscribers() > 0) publishRawCamera(stamp);
     }
   }
 }
@@ -403,7 +404,8 @@ void RobotModulesRos::publishRawCamera(const ros::Time& stamp) {
   img->height = static_cast<uint32_t>(camera_params_.height);
   img->encoding = "rgb8";
   img->step = img->width * 3;
-  raw_camera_->render(img->data);
+  // Rendered only for an image subscriber; camera_info alone is cheap.
+  if (camera_pub_.getNumSubscribers() > 0) raw_camera_->render(img->data);
   sensor_msgs::CameraInfoPtr info = boost::make_shared<sensor_msgs::CameraInfo>();
   info->header = img->header;
   info->width = img->width;
@@ -416,7 +418,8 @@ void RobotModulesRos::publishRawCamera(const ros::Time& stamp) {
   info->K = {radius, 0, 0.5 * camera_params_.width, 0, radius, 0.5 * camera_params_.height, 0, 0, 1};
   info->R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   info->P = {radius, 0, 0.5 * camera_params_.width, 0, 0, radius, 0.5 * camera_params_.height, 0, 0, 0, 1, 0};
-  camera_pub_.publish(img, info);
+  if (camera_pub_.getNumSubscribers() > 0) camera_pub_.publish(img);
+  camera_info_pub_.publish(info);
 }
 
 void RobotModulesRos::publishMarkers(const ros::Time& stamp) {

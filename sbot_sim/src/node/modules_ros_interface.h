@@ -110,7 +110,10 @@ class RobotModulesRos {
   std::unique_ptr<sbot::actuators::SideArm> side_arm_;
   std::unique_ptr<sbot::sensors::RawCamera> raw_camera_;
   sbot::sensors::RawCameraParams camera_params_;
-  image_transport::CameraPublisher camera_pub_;
+  // The image and its camera_info apart: a subscriber to camera_info alone (`rosbag record -a -x
+  // '.*image_raw.*'`) must not make every robot ray-cast an image nobody takes.
+  image_transport::Publisher camera_pub_;
+  ros::Publisher camera_info_pub_;
   std::map<std::string, Rate> rates_;
   double next_any_ = 0;  ///< [s] earliest rates_[*].next
   std::map<std::string, ros::Publisher> pubs_;

@@ -97,8 +97,10 @@ bool SimRosInterface::init() {
   try {
     scenario_ = sbot::loadScenario(params_.scenario, params_.robots);
     // ~level: every robot at one level (the world's step and gravity stay the scenario's).
-    if (!params_.level.empty())
+    if (!params_.level.empty()) {
       for (sbot::RobotSpawn& r : scenario_.robots) r.level = params_.level;
+      sbot::checkGravityOfLevels(scenario_, params_.scenario + " with ~level " + params_.level);
+    }
     if (!params_.effects.empty()) scenario_.effects_file = params_.effects;
     world_ = buildWorld();
   } catch (const sbot::ConfigError& e) {

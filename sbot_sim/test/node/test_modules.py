@@ -56,7 +56,7 @@ class Modules(unittest.TestCase):
         self.assertEqual(m.gripper, 'sticky')
         self.assertFalse(m.side_arm)
         f = latched('/sbot_1/sensors_available', SensorsAvailable)
-        self.assertEqual(f.level, 'fast')
+        self.assertEqual(f.level, 'simple')
         self.assertNotIn('light', f.channels)
         self.assertEqual(f.ir_model, 'lut')
         self.assertEqual(f.gripper, 'none')
@@ -129,9 +129,9 @@ class Modules(unittest.TestCase):
             if abs(st.elevation - 30) <= 2:
                 break
         self.assertLessEqual(abs(st.elevation - 30), 2)
-        fast = rospy.ServiceProxy('/sbot_1/set_gripper', SetGripper)(elevation=10, aperture=0)
-        self.assertTrue(fast.success)
-        self.assertIn('no gripper model', fast.message)
+        simple = rospy.ServiceProxy('/sbot_1/set_gripper', SetGripper)(elevation=10, aperture=0)
+        self.assertTrue(simple.success)
+        self.assertIn('no gripper model', simple.message)
 
     def test_side_arm_only_detailed(self):
         res = rospy.ServiceProxy('/sbot_0/set_side_arm', SetSideArm)(elevation=0, rotation=0, depth=60, jaws=0)
@@ -168,6 +168,8 @@ class Modules(unittest.TestCase):
 
     def test_raw_camera_when_subscribed(self):
         info = Collect('/sbot_0/camera/camera_info', CameraInfo)
+        # camera_info alone comes without an image subscriber (which alone makes the node render)
+        self.assertEqual(info.wait(1)[0].width, 640)
         img = rospy.wait_for_message('/sbot_0/camera/image_raw', Image, 30)
         self.assertEqual((img.width, img.height, img.encoding), (640, 448, 'rgb8'))
         self.assertEqual(len(img.data), 640 * 448 * 3)
@@ -178,7 +180,7 @@ class Modules(unittest.TestCase):
     def test_slope_flat(self):
         # On flat ground. The Medium model rests 3-4 deg nose down under quickstep at 20 iterations
         # (docs/validation/report.md, "Model facts": pitch 3.4 deg; 0.5 deg at 200 iterations), so
-        # its reading may be -4 (a bound of 3 failed a fresh-clone run on 2026-11-25); the Fast model rests level.
+        # its reading may be -4 (a bound of 3 failed a fresh-clone run on 2026-11-25); the Simple model rests level.
         s = rospy.wait_for_message('/sbot_0/slope', Slope, 20)
         self.assertLessEqual(abs(s.pitch), 5)
         self.assertLessEqual(abs(s.roll), 3)

@@ -62,4 +62,9 @@ struct Scenario {
 Scenario loadScenario(const std::string& path, int robot_count = -1);
 Scenario parseScenario(const std::string& yaml_text, const std::string& source, int robot_count = -1);
 
+/// The robots' levels against the world's gravity (the parsers call it; call it again after
+/// changing levels): a Fast robot only in its 1/50 g and never beside full-size robots. Throws
+/// ConfigError naming `source`, the robot and both gravities.
+void checkGravityOfLevels(const Scenario& scenario, const std::string& source);
+
 }  // namespace sbot
