@@ -108,7 +108,8 @@ void plotFig44(const std::string& path, const std::vector<double>& hrs,
   auto X = [&](int i) { return L + (W - L - R) * (i + 0.5) / hrs.size(); };
   auto Y = [&](double y) { return T + (H - T - B) * (ymax - y) / (ymax - ymin); };
   cv::rectangle(img, cv::Point(L, T), cv::Point(W - R, H - B), cv::Scalar(0, 0, 0), 1);
-  for (double y = ymin; y <= ymax + 1e-9; y += 0.2) {
+  for (int k = 0; ymin + 0.2 * k <= ymax + 1e-9; ++k) {
+    const double y = std::round((ymin + 0.2 * k) * 10) / 10 + 0.0;  // + 0.0: no "-0.0" label
     cv::line(img, cv::Point(L, Y(y)), cv::Point(W - R, Y(y)), cv::Scalar(220, 220, 220), 1);
     cv::putText(img, fmt(y, 1), cv::Point(L - 45, Y(y) + 5), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1);
   }
