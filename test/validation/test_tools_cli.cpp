@@ -66,6 +66,15 @@ TEST(ToolsCli, UnusableStudyKnobsAreRefusedByName) {
   EXPECT_NE(o.output.find("step detailed 0.01: pass"), std::string::npos) << o.output;
 }
 
+// Inputs that used to give a report anyway: a misspelt --only section (an empty report, status 0)
+// and an unreadable height map (288 failed runs shown as "0.00 +- 0.00" in Figure 4.4).
+TEST(ToolsCli, UnknownSectionsAndUnreadableHeightMapsAreRefusedBeforeAnyRun) {
+  const std::string out = "--out " + testing::TempDir() + "cli_refused ";
+  expectRefused("sbot_validate", out + "--only fig44", "--only: unknown section 'fig44' (sections: facts, 4.1");
+  expectRefused("sbot_validate", out + "--only fig4.4 --heightmap /nonexistent/map.png",
+                "--heightmap (or $SBOT_HEIGHTMAP): /nonexistent/map.png: field 'terrain.heightmap_image': cannot read image");
+}
+
 TEST(ToolsCli, AValidTrialRuns) {
   const Outcome o = run("sbot_validate", "--trial step detailed 0.010");
   EXPECT_EQ(o.status, 0) << o.output;
