@@ -25,8 +25,10 @@
 #include <vector>
 
 #include "sbot_sim/core/robot_description.h"
+#include "sbot_sim/core/scenario.h"  // kMaxRobots
 #include "sbot_sim/core/swarm/swarm_graph.h"
 #include "sbot_sim/core/world.h"
+#include "sbot_sim/tools/cli_args.h"
 
 namespace {
 
@@ -40,22 +42,21 @@ struct Options {
 };
 
 Options parse(int argc, char** argv) {
+  // Values are checked (atoi/atof turned "--robots 0" or "--seconds -1" into a row of nonsense).
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string {
-      if (i + 1 >= argc) { std::fprintf(stderr, "sbot_bench: %s needs a value\n", a.c_str()); std::exit(2); }
-      return argv[++i];
-    };
-    if (a == "--level") o.level = next();
-    else if (a == "--seconds") o.seconds = std::atof(next().c_str());
-    else if (a == "--step") o.step = std::atof(next().c_str());
-    else if (a == "--chains") o.chains = std::atoi(next().c_str());
+  sbot_tools::ArgReader args("sbot_bench", argc, argv);
+  while (args.more()) {
+    const std::string a = args.option();
+    if (a == "--level") o.level = args.value();
+    else if (a == "--seconds") o.seconds = args.number(0.001, 1e6);
+    else if (a == "--step") o.step = args.number(0, 1);  // 0: the level's recommended step
+    else if (a == "--chains") o.chains = args.count(0, sbot::kMaxRobots);
     else if (a == "--profile") o.profile = true;
     else if (a == "--robots") {
       o.robots.clear();
-      std::stringstream ss(next());
-      for (std::string n; std::getline(ss, n, ',');) o.robots.push_back(std::atoi(n.c_str()));
+      std::stringstream ss(args.value());
+      for (std::string n; std::getline(ss, n, ',');)
+        o.robots.push_back(sbot_tools::countArg("sbot_bench", "--robots", n, 1, sbot::kMaxRobots));
     } else {
       std::fprintf(stderr, "usage: sbot_bench [--level L] [--robots 1,10,100] [--seconds S] [--step DT] [--chains K] [--profile]\n");
       std::exit(a == "--help" ? 0 : 2);
@@ -143,6 +144,12 @@ void runOne(const Options& o, int n) {
 
 int main(int argc, char** argv) {
   const Options o = parse(argc, argv);
+  try {
+    sbot::loadLevel(o.level);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sbot_bench: --level: %s\n", e.what());
+    return 2;
+  }
   std::printf("sbot_bench: headless core, flat arena, random walk, 1 core per run\n");
   std::printf("%-8s %7s %10s %12s %14s %12s\n", "level", "robots", "sim_s", "RTM", "wall_ms/step", "peak_MiB");
   std::fflush(stdout);

@@ -30,7 +30,8 @@
 
 #include "experiments.h"
 #include "two_sbots_trials.h"
-#include "../common/cli_args.h"
+#include "sbot_sim/core/robot_description.h"
+#include "sbot_sim/tools/cli_args.h"
 
 namespace {
 
@@ -58,7 +59,15 @@ int main(int argc, char** argv) {
   sbot_tools::ArgReader args("two_sbots", argc, argv);
   while (args.more()) {
     const std::string a = args.option();
-    if (a == "--level") level = args.value();
+    if (a == "--level") {
+      level = args.value();
+      try {
+        sbot::loadLevel(level);
+      } catch (const std::exception& e) {  // was an uncaught exception (abort) at the first trial
+        std::fprintf(stderr, "two_sbots: --level: %s\n", e.what());
+        return 2;
+      }
+    }
     else if (a == "--trials") trials = args.count(1, 1000);
     else if (a == "--angles") angles = parseList(a, args.value(), 0, 90);    // [deg]
     else if (a == "--steps") steps = parseList(a, args.value(), 0, 0.2);     // [m]

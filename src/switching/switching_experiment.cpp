@@ -43,7 +43,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "course_run.h"
-#include "../common/cli_args.h"
+#include "sbot_sim/tools/cli_args.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/scenario.h"
 #include "sbot_sim/core/swarm/level_policy.h"

@@ -33,7 +33,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "experiments.h"
-#include "../common/cli_args.h"
+#include "sbot_sim/tools/cli_args.h"
 #include "two_sbots_trials.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/terrain.h"

@@ -1,4 +1,4 @@
-// The headless tools' options (sbot_validate, switching_experiment, two_sbots; src/common/cli_args.h):
+// The headless tools' options (sbot_validate, switching_experiment, two_sbots; sbot_sim/tools/cli_args.h):
 // a missing value, or a value that is not a number in range, is refused with exit status 2 and a
 // message that names the option and what was found (atoi/atof used to turn "abc" into a silent 0 runs
 // or trials).
@@ -33,6 +33,21 @@ TEST(ToolsCli, NonNumbersAndOutOfRangeValuesAreRefusedByName) {
   expectRefused("two_sbots", "--angles 10,x", "--angles expects a number in [0, 90], found 'x'");
   expectRefused("two_sbots", "--trials 2.5", "--trials expects a whole number, found '2.5'");
   expectRefused("two_sbots", "--track-mu -1", "--track-mu expects a number");
+  expectRefused("two_sbots", "--level huge", "two_sbots: --level: unknown model level 'huge'");  // aborted
+}
+
+// sbot_bench (package sbot_sim) reads the same way; it used to run rows of 0 robots or 0 seconds.
+TEST(ToolsCli, BenchRefusesWhatItCannotRun) {
+  const auto refused = [](const std::string& args, const std::string& message) {
+    const Outcome o = sbot_test::runProcess(std::string(SBOT_BENCH_BIN) + " " + args);
+    EXPECT_EQ(o.status, 2) << args << ": " << o.output;
+    EXPECT_NE(o.output.find(message), std::string::npos) << args << ": " << o.output;
+  };
+  refused("--robots 1,0", "sbot_bench: --robots expects a number in [1, 10000], found '0'");
+  refused("--seconds -1", "sbot_bench: --seconds expects a number in [0.001, 1e+06], found '-1'");
+  refused("--chains x", "sbot_bench: --chains expects a number");
+  refused("--level huge", "sbot_bench: --level: unknown model level 'huge'");
+  refused("--seconds", "sbot_bench: --seconds needs a value");
 }
 
 // The last option without its value (two_sbots used to read it as "": --level "" then failed later

@@ -1,4 +1,4 @@
-// Command-line options of the headless tools (sbot_validate, switching_experiment, two_sbots): an
+// Command-line options of the headless tools (sbot_validate, switching_experiment, two_sbots, sbot_bench): an
 // option missing its value, or a value that is not a finite number inside its range, is refused with
 // a message that names the tool, the option and what was found (exit status 2), instead of
 // atoi/atof's silent 0 or an empty string.
