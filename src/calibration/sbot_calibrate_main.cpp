@@ -62,6 +62,29 @@ struct Args {
 
 const std::set<std::string> kFlags{"no-plots", "quiet", "no-align", "torque", "no-tilt", "no-speed", "verbose", "help"};
 
+/// The options each subcommand reads (besides --jobs, --quiet, --help). Anything else is refused:
+/// a misspelt option would otherwise be ignored, e.g. `compare --effect F` comparing the nominal model.
+const std::map<std::string, std::set<std::string>> kCommandOptions{
+    {"compare", {"effects", "level", "solver", "out", "no-plots", "no-align"}},
+    {"diagnose", {"effects", "level", "solver", "folds", "threshold", "seed", "candidates", "write-effects", "verbose"}},
+    {"fit", {"effect", "effects", "level", "solver", "out"}},
+    {"generate", {"out", "level", "solver", "seed", "duration", "tilt", "repeat", "max-runs", "name", "torque",
+                  "no-tilt", "no-speed", "families", "hidden", "hide"}},
+    {"sweep", {"cases", "set", "seeds", "first-seed", "level", "solver", "duration", "folds", "threshold", "torque",
+               "out"}},
+    {"effects", {}}};
+
+/// Refuse an option the subcommand does not read (a misspelt one would otherwise be ignored).
+void refuseUnknownOption(const std::string& cmd, const std::string& k) {
+  auto it = kCommandOptions.find(cmd);
+  if (it == kCommandOptions.end()) return;  // unknown command: usage() says so
+  if (it->second.count(k) || k == "jobs" || k == "quiet" || k == "help") return;
+  std::string accepted;
+  for (const auto& o : it->second) accepted += " --" + o;
+  throw std::invalid_argument("unknown option --" + k + " for '" + cmd + "' (it takes" +
+                              (accepted.empty() ? std::string(" none") : accepted) + ", and --jobs, --quiet)");
+}
+
 Args parse(int argc, char** argv) {
   Args a;
   if (argc < 2) return a;
@@ -76,6 +99,7 @@ Args parse(int argc, char** argv) {
       } else if (kFlags.count(s)) {
         a.flags.insert(s);
       } else {
+        refuseUnknownOption(a.cmd, s);  // before "needs a value": a trailing misspelt option
         if (i + 1 >= argc) throw std::invalid_argument("--" + s + " needs a value");
         a.opts.emplace(s, argv[++i]);
       }
@@ -86,31 +110,9 @@ Args parse(int argc, char** argv) {
   return a;
 }
 
-/// The options each subcommand reads (besides --jobs, --quiet, --help). Anything else is refused:
-/// a misspelt option would otherwise be ignored, e.g. `compare --effect F` comparing the nominal model.
-const std::map<std::string, std::set<std::string>> kCommandOptions{
-    {"compare", {"effects", "level", "solver", "out", "no-plots", "no-align"}},
-    {"diagnose", {"effects", "level", "solver", "folds", "threshold", "seed", "candidates", "write-effects", "verbose"}},
-    {"fit", {"effect", "effects", "level", "solver", "out"}},
-    {"generate", {"out", "level", "solver", "seed", "duration", "tilt", "repeat", "max-runs", "name", "torque",
-                  "no-tilt", "no-speed", "families", "hidden", "hide"}},
-    {"sweep", {"cases", "set", "seeds", "first-seed", "level", "solver", "duration", "folds", "threshold", "torque",
-               "out"}},
-    {"effects", {}}};
-
 void checkOptions(const Args& a) {
-  auto it = kCommandOptions.find(a.cmd);
-  if (it == kCommandOptions.end()) return;  // unknown command: usage() says so
-  std::set<std::string> given;
-  for (const auto& [k, v] : a.opts) given.insert(k);
-  given.insert(a.flags.begin(), a.flags.end());
-  for (const auto& k : given) {
-    if (it->second.count(k) || k == "jobs" || k == "quiet" || k == "help") continue;
-    std::string accepted;
-    for (const auto& o : it->second) accepted += " --" + o;
-    throw std::invalid_argument("unknown option --" + k + " for '" + a.cmd + "' (it takes" +
-                                (accepted.empty() ? std::string(" none") : accepted) + ", and --jobs, --quiet)");
-  }
+  for (const auto& [k, v] : a.opts) refuseUnknownOption(a.cmd, k);
+  for (const auto& k : a.flags) refuseUnknownOption(a.cmd, k);
 }
 
 std::string pct(double v) {

@@ -23,6 +23,10 @@ TEST(Cli, AnOptionTheSubcommandDoesNotTakeIsRefusedByName) {
   const Outcome d = run("diagnose " + kExample + " --treshold 5");
   EXPECT_EQ(d.status, 1) << d.output;
   EXPECT_NE(d.output.find("unknown option --treshold for 'diagnose'"), std::string::npos) << d.output;
+  // Last on the line, a misspelt option is named as such (it used to "need a value").
+  const Outcome last = run("compare " + kExample + " --no-plot");
+  EXPECT_EQ(last.status, 1) << last.output;
+  EXPECT_NE(last.output.find("unknown option --no-plot for 'compare'"), std::string::npos) << last.output;
 }
 
 TEST(Cli, ABadSolverIsRefusedByName) {
