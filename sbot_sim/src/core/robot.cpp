@@ -577,6 +577,8 @@ std::vector<JointState> Robot::jointStates() const {
 }
 
 void Robot::setBasePose(const Pose& pose) {
+  const std::string where = positionProblem(pose.position);
+  if (!where.empty()) throw ConfigError("<world>", "robot " + name_, where);
   const Pose old_base_body = bodyPose(baseBody());
   const Pose new_base_body = pose * base_body_T_base_.inverse();
   for (dBodyID b : bodies_) {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <sstream>
 
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/geom_info.h"
@@ -94,8 +95,25 @@ World::~World() {
   dWorldDestroy(world_);
 }
 
+std::string positionProblem(const Vec3& p) {
+  if (p.allFinite() && p.cwiseAbs().maxCoeff() <= kMaxCoordinate) return "";
+  std::ostringstream msg;
+  msg << "position (" << p.x() << ", " << p.y() << ", " << p.z() << ") m is outside the simulated space (every "
+      << "coordinate finite and within +-" << kMaxCoordinate << " m)";
+  return msg.str();
+}
+
 void World::buildTerrain() {
   const TerrainConfig& t = config_.terrain;
+  for (const auto& box : t.boxes) {
+    std::string problem = positionProblem(box.center);
+    if (problem.empty()) problem = positionProblem(box.size);
+    if (!problem.empty()) throw ConfigError("<world>", "terrain.boxes (" + box.name + ")", problem);
+  }
+  if (t.type == TerrainConfig::Type::Rough) {
+    const std::string problem = positionProblem(Vec3(t.size_x, t.size_y, t.height_range));
+    if (!problem.empty()) throw ConfigError("<world>", "terrain (size, height_range)", problem);
+  }
   auto addStatic = [this](dGeomID g, const std::string& material, const std::string& name) {
     dGeomSetData(g, new GeomInfo{nullptr, material, name});
     static_geoms_.push_back(g);
@@ -161,6 +179,8 @@ Robot& World::addRobotAt(const RobotDescription& description, const Pose& pose, 
   if (findRobot(name)) throw ConfigError("<world>", "robots", "duplicate robot name '" + name + "'");
   const std::string problem = robotNameProblem(name);
   if (!problem.empty()) throw ConfigError("<world>", "robots", problem);
+  const std::string where = positionProblem(pose.position);
+  if (!where.empty()) throw ConfigError("<world>", "robots (" + name + ")", where);
   robots_.push_back(std::make_unique<Robot>(*this, description, name, next_index_++, pose));
   updateSolverIterations();
   return *robots_.back();

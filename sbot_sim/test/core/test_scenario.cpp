@@ -114,6 +114,27 @@ TEST(Scenario, FastNeedsItsGravityAndRunsAlone) {
   EXPECT_EQ(gravityProblem(loadLevel("medium"), 0.1962), "") << "full-size levels take any gravity";
 }
 
+// Positions ODE's collision spaces cannot index (a robot spawned at x = 1e300 stopped the simulator
+// with an ODE assertion): refused by the World wherever a robot or a box enters it, naming it.
+TEST(Scenario, PositionsOutsideTheSimulatedSpaceAreRefused) {
+  World w(WorldConfig{});
+  try {
+    w.addRobot(loadLevel("simple"), {1e300, 0, 0}, "far");
+    ADD_FAILURE() << "a robot at x = 1e300 was spawned";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("robots (far)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("outside the simulated space"), std::string::npos) << e.what();
+  }
+  Robot& r = w.addRobot(loadLevel("simple"), {0, 0, 0}, "near");
+  EXPECT_THROW(r.setBasePose(Pose(Vec3(0, -2e5, 0.1), Quat::Identity())), ConfigError);
+  EXPECT_NO_THROW(r.setBasePose(Pose(Vec3(0, -9e4, 0.1), Quat::Identity()))) << "inside: 90 km";
+  w.stepN(10);  // and the world still steps
+  WorldConfig c;
+  c.terrain.type = TerrainConfig::Type::Composite;
+  c.terrain.boxes.push_back({"huge", Vec3(0, 0, 0), Vec3(1e300, 1, 1), 0, 0, "ground"});
+  EXPECT_THROW(World{c}, ConfigError);
+}
+
 // The same rule guards the other way robots enter a world (the node's /sim/spawn, tools).
 TEST(Scenario, TheWorldRefusesRobotNamesRosCannotUse) {
   World w(WorldConfig{});

@@ -99,6 +99,9 @@ class TestSwarm(unittest.TestCase):
         self.assertFalse(res.success)
         res = self.spawn('sbot_9', 'simple', float('nan'), 1.0, 0.0)
         self.assertFalse(res.success)
+        res = self.spawn('sbot_9', 'simple', 1e300, 1.0, 0.0)  # stopped the node with an ODE assertion
+        self.assertFalse(res.success)
+        self.assertIn('outside the simulated space', res.message)
         res = self.spawn('sbot_9', 'fast', 1.0, 1.0, 0.0)  # scaled for 1/50 g, this world has 9.81
         self.assertFalse(res.success)
         self.assertIn('scaled for a gravity of 0.1962', res.message)

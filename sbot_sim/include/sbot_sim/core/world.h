@@ -30,6 +30,13 @@ struct RayHit {
 /// name rules for one segment: a letter, then letters, digits or '_'.
 std::string robotNameProblem(const std::string& name);
 
+/// The simulated space: every coordinate of a robot or a terrain box within +-kMaxCoordinate [m].
+/// ODE's collision spaces cannot index geometry far beyond it (a robot spawned at x = 1e300 stopped
+/// the simulator with an ODE assertion).
+constexpr double kMaxCoordinate = 1e5;
+/// What is wrong with `p` [m] as a position in the world ("" when it is finite and inside).
+std::string positionProblem(const Vec3& p);
+
 class World {
  public:
   explicit World(const WorldConfig& config);
