@@ -15,6 +15,7 @@
 
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/scenario.h"
+#include "sbot_sim/core/world.h"  // positionProblem
 
 namespace sbot::calib {
 namespace {
@@ -478,6 +479,8 @@ Dataset loadDataset(const std::string& path_in) {
         Lamp l;
         if (!lamps[i]["position"]) fail(f, lamps[i], field + ".position", "missing");
         l.position = vec3(lamps[i]["position"], f, field + ".position");
+        const std::string where = positionProblem(l.position);
+        if (!where.empty()) fail(f, lamps[i]["position"], field + ".position", where);
         l.intensity = lamps[i]["intensity"] ? number(lamps[i]["intensity"], f, field + ".intensity") : 0.0;
         if (l.intensity < 0) fail(f, lamps[i]["intensity"], field + ".intensity", "must be >= 0");
         ds.lamps.push_back(l);

@@ -649,6 +649,8 @@ ModulesRosInterface::ModulesRosInterface(ros::NodeHandle nh, ros::NodeHandle pnh
         const YAML::Node p = l["position"];
         if (!p || !p.IsSequence() || p.size() != 3) throw std::runtime_error("world.lamps[].position: expected [x, y, z]");
         s.position = sbot::Vec3(p[0].as<double>(), p[1].as<double>(), p[2].as<double>());
+        const std::string where = sbot::positionProblem(s.position);
+        if (!where.empty()) throw std::runtime_error("world.lamps[].position: " + where);
         s.intensity = l["intensity"] ? l["intensity"].as<double>() : 0.0;
         if (!std::isfinite(s.intensity) || s.intensity < 0) throw std::runtime_error("world.lamps[].intensity: expected >= 0 mcd");
         if (const YAML::Node c = l["colour"]) s.colour = sbot::Vec3(c[0].as<double>(), c[1].as<double>(), c[2].as<double>());

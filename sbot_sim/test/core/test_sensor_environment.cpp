@@ -93,6 +93,9 @@ TEST(Environment, LampsAmbientAndSpeakers) {
   EXPECT_THROW(env.setLampIntensity(2, 1), std::out_of_range);
   EXPECT_THROW(env.getLampIntensity(-1), std::out_of_range);
   EXPECT_THROW(env.setLampIntensity(0, -1), std::invalid_argument);
+  // Light sensors cast rays towards every lamp: one beyond the simulated space is refused.
+  EXPECT_THROW(env.addLamp(Vec3(1e300, 0, 1), 10), std::invalid_argument);
+  EXPECT_THROW(env.setLampPosition(0, Vec3(0, 0, std::nan(""))), std::invalid_argument);
   env.setAmbientLight(3.5);
   EXPECT_DOUBLE_EQ(env.getAmbientLight(), 3.5);
   EXPECT_FALSE(env.speaker("s").on);

@@ -47,6 +47,9 @@ int Environment::addLamp(const Vec3& position, double intensity_mcd, const Vec3&
   if (!(intensity_mcd >= 0) || !std::isfinite(intensity_mcd)) {
     throw std::invalid_argument("lamp intensity must be a finite value >= 0 [mcd]");
   }
+  // The light sensors cast occlusion rays towards each lamp; ODE cannot index rays that long.
+  const std::string where = positionProblem(position);
+  if (!where.empty()) throw std::invalid_argument("lamp: " + where);
   lamps_.push_back(Lamp{position, intensity_mcd, colour});
   return static_cast<int>(lamps_.size()) - 1;
 }
@@ -66,6 +69,8 @@ double Environment::getLampIntensity(int nr) const {
 
 void Environment::setLampPosition(int nr, const Vec3& position) {
   if (nr < 0 || nr >= static_cast<int>(lamps_.size())) throw std::out_of_range("no lamp " + std::to_string(nr));
+  const std::string where = positionProblem(position);
+  if (!where.empty()) throw std::invalid_argument("lamp " + std::to_string(nr) + ": " + where);
   lamps_[nr].position = position;
 }
 
