@@ -467,13 +467,18 @@ std::vector<std::pair<Vec3, double>> levelIrSensors(const std::string& level) {
   return out;
 }
 
+WorldConfig replayWorldConfig(const Dataset& ds, const RobotDescription& level, const ReplayOptions& opt) {
+  WorldConfig wc = opt.world_override ? *opt.world_override : ds.world;
+  if (!ds.world_sets_step) wc.step = level.recommended_step;
+  if (!ds.world_sets_gravity) wc.gravity = level.gravity;
+  return wc;
+}
+
 RunPrediction replayRun(const Dataset& ds, const Run& run, const ModelSpec& model, const ReplayOptions& opt) {
   ++g_replays;
   WorkerPool::count();
   const RobotDescription& d = loadLevel(model.level.empty() ? ds.robot : model.level);
-  WorldConfig wc = opt.world_override ? *opt.world_override : ds.world;
-  if (!ds.world_sets_step) wc.step = d.recommended_step;
-  if (!ds.world_sets_gravity) wc.gravity = d.gravity;
+  const WorldConfig wc = replayWorldConfig(ds, d, opt);
   PerWorldThreading threading;
   World world(wc);
   threading.attach(world);

@@ -8,6 +8,7 @@
 
 #include "calibration/dataset.h"
 #include "sbot_sim/core/effects/effects_file.h"
+#include "sbot_sim/core/robot_description.h"
 
 namespace sbot::calib {
 
@@ -51,6 +52,10 @@ struct RunPrediction {
 };
 
 RunPrediction replayRun(const Dataset& ds, const Run& run, const ModelSpec& model, const ReplayOptions& opt);
+
+/// The world a replay runs in: the dataset's (or opt.world_override), with the model level's
+/// recommended step and gravity unless the dataset wrote its own (Dataset::world_sets_*).
+WorldConfig replayWorldConfig(const Dataset& ds, const RobotDescription& level, const ReplayOptions& opt);
 
 /// True when the core can simulate this channel (sensor modules present for ir/ground/light).
 bool canSimulateChannel(const std::string& channel);

@@ -7,6 +7,8 @@
 #include <fstream>
 
 #include "calibration/dataset.h"
+#include "calibration/replay.h"
+#include "sbot_sim/core/robot_description.h"
 
 namespace sbot::calib {
 namespace {
@@ -171,6 +173,9 @@ TEST(Dataset, WorldGravityAndStepAreKeptOrRefused) {
   EXPECT_TRUE(moon.world_sets_gravity);
   EXPECT_TRUE(moon.world_sets_step);
   EXPECT_DOUBLE_EQ(moon.world.gravity, 1.62);
+  const WorldConfig replayed = replayWorldConfig(moon, loadLevel("simple"), ReplayOptions{});
+  EXPECT_DOUBLE_EQ(replayed.gravity, 1.62) << "the replays use it";
+  EXPECT_DOUBLE_EQ(replayed.step, 0.005);
   const std::string copy = tempDir("moon_copy");
   writeDataset(moon, copy);
   const Dataset again = loadDataset(copy);
@@ -180,6 +185,8 @@ TEST(Dataset, WorldGravityAndStepAreKeptOrRefused) {
   const Dataset plain = loadDataset(makeDataset("plain", "t,cmd_left,cmd_right,x\n0,1,1,0\n"));
   EXPECT_FALSE(plain.world_sets_gravity);
   EXPECT_FALSE(plain.world_sets_step);
+  EXPECT_DOUBLE_EQ(replayWorldConfig(plain, loadLevel("fast"), ReplayOptions{}).gravity, loadLevel("fast").gravity)
+      << "unwritten: the model level's";
   // The Fast level is scaled for 1/50 g: a dataset may not put it under 9.81.
   std::string fast = kYaml;
   fast.replace(fast.find("robot: simple"), 13, "robot: fast");

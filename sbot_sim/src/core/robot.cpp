@@ -674,6 +674,7 @@ void Robot::applyBodyDrive(const TrackCommand& cmd) {
   const Vec3 up = bodyPose(baseBody()).orientation * Vec3::UnitZ();
   const double traction =
       world_.config().contact.muFor("track", "ground") * std::max(0.0, driveContactForce().dot(up));
+  drive_traction_ = traction;
   double v = 0, yaw_rate = 0, f_max = 0, t_max = 0;
   if (passive_) {
     f_max = std::min(traction, tr.backdrive_force);  // gear back-drive: the pull needed to move it

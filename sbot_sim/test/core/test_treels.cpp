@@ -479,6 +479,9 @@ TEST(TreelsFast, TractionComesFromTheLoadNotFromASidePush) {
   EXPECT_GT(r.driveWheelLoad(), 1.3 * weight) << "the wall's push is in the contacts' normal load";
   EXPECT_NEAR(f.dot(r.basePose().orientation * Vec3::UnitZ()), weight, 0.2 * weight)
       << "but not in the load along the chassis' up axis";
+  w.step();  // the drive's traction for the next step comes from that load: mu (track 1.0) x weight
+  const double mu = w.config().contact.muFor("track", "ground");
+  EXPECT_NEAR(r.bodyDriveTraction(), mu * weight, 0.2 * mu * weight) << "not mu x the normal forces' sum";
 }
 
 TEST(TreelsFast, PassiveFastRobotHoldsBelowItsScaledBackDriveForce) {

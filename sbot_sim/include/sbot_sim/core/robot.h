@@ -90,6 +90,8 @@ class Robot {
   /// traction from the part along the chassis' up axis: what presses the tracks onto their
   /// support, not a wall or robot pushing from the side.
   const Vec3& driveContactForce() const { return drive_contact_force_; }
+  /// Fast's body drive: the traction it was given in the last step [N] (0 for wheel drives).
+  double bodyDriveTraction() const { return drive_traction_; }
   /// Turret angle [rad] relative to the treels.
   double turretAngle() const;
   /// The turret is welded to the treels (WorldConfig::lock_idle_turret: quickstep, turrets whose
@@ -244,6 +246,7 @@ class Robot {
   dJointID drive_angular_ = nullptr;  ///< AMotor, axis chassis z
   dJointFeedback drive_linear_fb_{}, drive_angular_fb_{};
   double drive_torque_[2] = {0, 0};   ///< [N m] per track (left, right), last step
+  double drive_traction_ = 0;         ///< [N] see bodyDriveTraction()
   // Per-step track torques of the last treels.torque_window (ring buffer) and their running sum.
   std::vector<std::array<double, 2>> torque_history_;
   std::size_t torque_next_ = 0;
