@@ -360,10 +360,17 @@ const std::vector<std::string>& modelLevels() {
   return levels;
 }
 
+namespace {
+constexpr double kGravityTolerance = 0.01;  // relative
+}
+
+bool scaledForItsGravity(const RobotDescription& d) {
+  constexpr double kEarth = 9.81;  // [m/s^2]
+  return std::abs(d.gravity - kEarth) > kGravityTolerance * kEarth;
+}
+
 std::string gravityProblem(const RobotDescription& d, double world_gravity) {
-  constexpr double kEarth = 9.81, kTolerance = 0.01;  // [m/s^2], relative
-  const bool scaled = std::abs(d.gravity - kEarth) > kTolerance * kEarth;
-  if (!scaled || std::abs(world_gravity - d.gravity) <= kTolerance * d.gravity) return "";
+  if (!scaledForItsGravity(d) || std::abs(world_gravity - d.gravity) <= kGravityTolerance * d.gravity) return "";
   std::ostringstream msg;
   msg << "level " << d.level << " is scaled for a gravity of " << d.gravity << " m/s^2 (" << d.sidecar_path
       << "), this world has " << world_gravity << " m/s^2: set the world's gravity to " << d.gravity

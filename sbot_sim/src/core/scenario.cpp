@@ -237,17 +237,17 @@ void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
 // The Fast level is scaled for 1/50 g (seed 3.1, 4.2.4: "tested separately and alone"): refuse it
 // under another gravity, and beside full-size robots, which would then live in 1/50 g.
 void checkGravityOfLevels(const Scenario& s, const std::string& file) {
-  std::string scaled, full_size;
-  for (std::size_t i = 0; i < s.robots.size(); ++i) {
-    const RobotDescription& d = loadLevel(s.robots[i].level);
+  const RobotDescription* scaled = nullptr;
+  const RobotDescription* full_size = nullptr;
+  for (const RobotSpawn& r : s.robots) {
+    const RobotDescription& d = loadLevel(r.level);
     const std::string problem = gravityProblem(d, s.world.gravity);
-    if (!problem.empty()) throw ConfigError(file, "robots (" + s.robots[i].name + ")", problem);
-    const bool bound_to_its_gravity = !gravityProblem(d, 9.81).empty();  // not usable on Earth: scaled
-    (bound_to_its_gravity ? scaled : full_size) = d.level;
+    if (!problem.empty()) throw ConfigError(file, "robots (" + r.name + ")", problem);
+    (scaledForItsGravity(d) ? scaled : full_size) = &d;
   }
-  if (!scaled.empty() && !full_size.empty())
-    throw ConfigError(file, "robots", "level " + scaled + " is scaled for " + std::to_string(loadLevel(scaled).gravity) +
-                                          " m/s^2 and cannot share a world with full-size robots (" + full_size +
+  if (scaled && full_size)
+    throw ConfigError(file, "robots", "level " + scaled->level + " is scaled for " + std::to_string(scaled->gravity) +
+                                          " m/s^2 and cannot share a world with full-size robots (" + full_size->level +
                                           "); the seed runs it alone (4.2.4)");
 }
 

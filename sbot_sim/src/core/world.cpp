@@ -430,7 +430,9 @@ void boxCallback(void* data, dGeomID o1, dGeomID o2) {
 
 std::vector<RayHit> World::castRays(const Vec3& origin, const std::vector<Vec3>& directions, double length,
                                     const Robot* ignore) const {
-  std::vector<RayHit> hits(directions.size());
+  RayHit miss;
+  miss.distance = length;
+  std::vector<RayHit> hits(directions.size(), miss);
   if (directions.empty()) return hits;
   // One broad-phase search for the box around every ray's segment instead of one per ray: for a
   // sensor's 5-ray cone that was most of the cost of a ray (ODE's space traversal), and a ray can
@@ -450,13 +452,9 @@ std::vector<RayHit> World::castRays(const Vec3& origin, const std::vector<Vec3>&
   BoxQuery box{query_box_, ignore, &ray_candidates_};
   dSpaceCollide2(query_box_, reinterpret_cast<dGeomID>(space_), &box, &boxCallback);
   dSpaceCollide2(query_box_, reinterpret_cast<dGeomID>(static_space_), &box, &boxCallback);
-  if (ray_candidates_.empty()) {
-    for (RayHit& h : hits) h.distance = length;
-    return hits;
-  }
+  if (ray_candidates_.empty()) return hits;
   dGeomID ray = queryRay(length);
   for (std::size_t i = 0; i < directions.size(); ++i) {
-    hits[i].distance = length;
     const Vec3 d = directions[i].normalized();
     dGeomRaySet(ray, origin.x(), origin.y(), origin.z(), d.x(), d.y(), d.z());
     RayQuery query{ignore, &hits[i]};

@@ -391,12 +391,13 @@ void RobotModulesRos::update(double dt, double sim_time) {
     if (sim_time + 1e-9 >= r.next) {
       r.next += 1.0 / r.hz;
       if (r.next <= sim_time) r.next = sim_time + 1.0 / r.hz;
-      if (camera_pub_.getNumSubscribers() > 0 || camera_info_pub_.getNumSubscribers() > 0) publishRawCamera(stamp);
+      const bool image = camera_pub_.getNumSubscribers() > 0;
+      if (image || camera_info_pub_.getNumSubscribers() > 0) publishRawCamera(stamp, image);
     }
   }
 }
 
-void RobotModulesRos::publishRawCamera(const ros::Time& stamp) {
+void RobotModulesRos::publishRawCamera(const ros::Time& stamp, bool with_image) {
   sensor_msgs::ImagePtr img = boost::make_shared<sensor_msgs::Image>();
   img->header.stamp = stamp;
   img->header.frame_id = name_ + "/camera";
@@ -405,7 +406,7 @@ void RobotModulesRos::publishRawCamera(const ros::Time& stamp) {
   img->encoding = "rgb8";
   img->step = img->width * 3;
   // Rendered only for an image subscriber; camera_info alone is cheap.
-  if (camera_pub_.getNumSubscribers() > 0) raw_camera_->render(img->data);
+  if (with_image) raw_camera_->render(img->data);
   sensor_msgs::CameraInfoPtr info = boost::make_shared<sensor_msgs::CameraInfo>();
   info->header = img->header;
   info->width = img->width;
@@ -418,7 +419,7 @@ void RobotModulesRos::publishRawCamera(const ros::Time& stamp) {
   info->K = {radius, 0, 0.5 * camera_params_.width, 0, radius, 0.5 * camera_params_.height, 0, 0, 1};
   info->R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   info->P = {radius, 0, 0.5 * camera_params_.width, 0, 0, radius, 0.5 * camera_params_.height, 0, 0, 0, 1, 0};
-  if (camera_pub_.getNumSubscribers() > 0) camera_pub_.publish(img);
+  if (with_image) camera_pub_.publish(img);
   camera_info_pub_.publish(info);
 }
 

@@ -92,7 +92,7 @@ class RobotModulesRos {
                       bool& any_single);
   void publishAvailable();
   void publishMarkers(const ros::Time& stamp);
-  void publishRawCamera(const ros::Time& stamp);
+  void publishRawCamera(const ros::Time& stamp, bool with_image);  ///< camera_info always, the image if asked
   void onLeds(const sbot_msgs::LedState::ConstPtr& msg);
   void onSpeaker(const std_msgs::Float64::ConstPtr& msg);
   bool onSetGripper(sbot_msgs::SetGripper::Request& req, sbot_msgs::SetGripper::Response& res);

@@ -205,12 +205,13 @@ bool SwarmRosInterface::onSpawn(sbot_msgs::Spawn::Request& req, sbot_msgs::Spawn
   }
   sbot::Robot* robot = nullptr;
   try {
-    const std::string gravity = sbot::gravityProblem(sbot::loadLevel(req.level), world_->config().gravity);
+    const sbot::RobotDescription& level = sbot::loadLevel(req.level);
+    const std::string gravity = sbot::gravityProblem(level, world_->config().gravity);
     if (!gravity.empty()) {
       res.message = gravity;
       return true;
     }
-    robot = &world_->addRobot(sbot::loadLevel(req.level), sbot::Pose2D{req.x, req.y, req.yaw}, req.name);
+    robot = &world_->addRobot(level, sbot::Pose2D{req.x, req.y, req.yaw}, req.name);
   } catch (const std::exception& e) {
     res.message = e.what();
     return true;

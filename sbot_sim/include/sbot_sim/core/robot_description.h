@@ -114,6 +114,9 @@ const std::vector<std::string>& modelLevels();
 /// Load a level by name from descriptionDirectory(); cached, so spawning many robots parses once.
 const RobotDescription& loadLevel(const std::string& level);
 
+/// True for a level made for a reduced gravity (Fast: half size, 1/20 mass, motors scaled for 1/50 g).
+bool scaledForItsGravity(const RobotDescription& d);
+
 /// Why a robot of `d` cannot live in a world of `world_gravity` [m/s^2], or "" when it can. Only a
 /// level made for a reduced gravity (Fast: half size, 1/20 mass, motors scaled for 1/50 g, seed 3.1)
 /// is bound to it; the full-size levels carry real masses and torques and work under any gravity.
