@@ -20,6 +20,7 @@ import unittest
 import rospy
 import rostest
 from nav_msgs.msg import Odometry
+from sbot_msgs.msg import TurretState
 
 from paused_sim import unpause_and_run, wait_for_controllers
 
@@ -35,6 +36,8 @@ class ControllerOutcome(unittest.TestCase):
         self.lamp = rospy.get_param('~lamp', [0.0, 0.0])
         self.lock = threading.Lock()
         self.pose = {}
+        self.heading = {}  # [rad] latest yaw per robot, for the failure report
+        self.turret = {}  # [API units, 2 deg] latest measured turret rotation per robot
         self.start = {}
         self.travel = {r: 0.0 for r in self.robots}
         self.t0 = None
@@ -42,6 +45,12 @@ class ControllerOutcome(unittest.TestCase):
         self.collisions = []
         self.subs = [rospy.Subscriber('/%s/ground_truth' % r, Odometry, self.on_pose, r, queue_size=1000,
                                       tcp_nodelay=True) for r in self.robots]
+        self.turret_subs = [rospy.Subscriber('/%s/turret/state' % r, TurretState, self.on_turret, r, queue_size=1)
+                            for r in self.robots]
+
+    def on_turret(self, msg, robot):
+        with self.lock:
+            self.turret[robot] = msg.rotation
 
     def on_pose(self, msg, robot):
         p = (msg.pose.pose.position.x, msg.pose.pose.position.y)
@@ -55,6 +64,8 @@ class ControllerOutcome(unittest.TestCase):
                 q = self.pose[robot]
                 self.travel[robot] += math.hypot(p[0] - q[0], p[1] - q[1])
             self.pose[robot] = p
+            q = msg.pose.pose.orientation
+            self.heading[robot] = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
             self.t_last = max(self.t_last, t)
             limit = 2 * self.radius - 0.005
             for other, q in self.pose.items():
@@ -103,7 +114,20 @@ class ControllerOutcome(unittest.TestCase):
                 print('phototaxis: mean distance to the lamp %.2f m -> %.2f m; robot-robot contacts: %d samples'
                       % (d0, d1, len(self.collisions)), file=sys.stderr)
                 self.assertLess(d1, d0 - rospy.get_param('~min_gain', 1.0),
-                                'mean distance to the lamp %.2f m -> %.2f m' % (d0, d1))
+                                'mean distance to the lamp %.2f m -> %.2f m; at the end: %s' % (d0, d1, self.final_states()))
+
+    def final_states(self):
+        """Per robot at the end: position, distance and bearing to the lamp (0 = ahead, + = left) and
+        the turret rotation, so that a failed run says whether a robot was lost, orbiting or turned away."""
+        out = []
+        for r in self.robots:
+            x, y = self.pose.get(r, (float('nan'), float('nan')))
+            yaw = self.heading.get(r, float('nan'))
+            bearing = math.degrees(math.atan2(self.lamp[1] - y, self.lamp[0] - x) - yaw)
+            bearing = (bearing + 180) % 360 - 180
+            out.append('%s at (%.2f, %.2f) %.2f m from the lamp, lamp bearing %.0f deg, turret %s units' % (
+                r, x, y, math.hypot(self.lamp[0] - x, self.lamp[1] - y), bearing, self.turret.get(r, 'unknown')))
+        return '; '.join(out)
 
 
 if __name__ == '__main__':
