@@ -59,15 +59,7 @@ int main(int argc, char** argv) {
   sbot_tools::ArgReader args("two_sbots", argc, argv);
   while (args.more()) {
     const std::string a = args.option();
-    if (a == "--level") {
-      level = args.value();
-      try {
-        sbot::loadLevel(level);
-      } catch (const std::exception& e) {  // was an uncaught exception (abort) at the first trial
-        std::fprintf(stderr, "two_sbots: --level: %s\n", e.what());
-        return 2;
-      }
-    }
+    if (a == "--level") level = args.value();
     else if (a == "--trials") trials = args.count(1, 1000);
     else if (a == "--angles") angles = parseList(a, args.value(), 0, 90);    // [deg]
     else if (a == "--steps") steps = parseList(a, args.value(), 0, 0.2);     // [m]
@@ -80,6 +72,12 @@ int main(int argc, char** argv) {
                            "[--seed-friction | --track-mu MU] [--rear-uphill]\n");
       return a == "--help" ? 0 : 2;
     }
+  }
+  try {  // the default level too: an unreadable description aborted the tool at its first trial
+    sbot::loadLevel(level);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "two_sbots: --level %s (or $SBOT_DESCRIPTION_DIR): %s\n", level.c_str(), e.what());
+    return 2;
   }
   const std::string friction = setup.seed_friction ? "seed (force limit 1.2 N per contact)"
                                : "Coulomb (treels mu " + std::to_string(setup.track_mu > 0 ? setup.track_mu : 1.0).substr(0, 4) + ")";

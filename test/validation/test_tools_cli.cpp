@@ -33,7 +33,8 @@ TEST(ToolsCli, NonNumbersAndOutOfRangeValuesAreRefusedByName) {
   expectRefused("two_sbots", "--angles 10,x", "--angles expects a number in [0, 90], found 'x'");
   expectRefused("two_sbots", "--trials 2.5", "--trials expects a whole number, found '2.5'");
   expectRefused("two_sbots", "--track-mu -1", "--track-mu expects a number");
-  expectRefused("two_sbots", "--level huge", "two_sbots: --level: unknown model level 'huge'");  // aborted
+  expectRefused("two_sbots", "--level huge", "two_sbots: --level huge (or $SBOT_DESCRIPTION_DIR): unknown model level 'huge'");  // aborted
+  expectRefused("sbot_validate", "--trial step huge 0.01", "sbot_validate: --trial step huge: unknown model level 'huge'");  // aborted
 }
 
 // sbot_bench (package sbot_sim) reads the same way; it used to run rows of 0 robots or 0 seconds.
@@ -88,6 +89,26 @@ TEST(ToolsCli, UnknownSectionsAndUnreadableHeightMapsAreRefusedBeforeAnyRun) {
   expectRefused("sbot_validate", out + "--only fig44", "--only: unknown section 'fig44' (sections: facts, 4.1");
   expectRefused("sbot_validate", out + "--only fig4.4 --heightmap /nonexistent/map.png",
                 "--heightmap (or $SBOT_HEIGHTMAP): /nonexistent/map.png: field 'terrain.heightmap_image': cannot read image");
+}
+
+// A model description that cannot be read ($SBOT_DESCRIPTION_DIR, the sweep tool's variants): two_sbots
+// and sbot_validate --trial aborted on an uncaught exception, and a report was written anyway with every
+// model fact "error" and every static tipping angle "> 90 deg" (a failed run read as a number), status 0.
+TEST(ToolsCli, AnUnreadableModelDescriptionIsRefusedBeforeAnyRun) {
+  const std::string env = "env SBOT_DESCRIPTION_DIR=/nonexistent/descriptions " + std::string(SWARMBOT3D_BIN_DIR) + "/";
+  const std::string missing = "/nonexistent/descriptions/urdf/";
+  Outcome o = sbot_test::runProcess(env + "two_sbots --trials 1 --angles 10 --steps 0.032");
+  EXPECT_EQ(o.status, 2) << o.output;
+  EXPECT_NE(o.output.find("two_sbots: --level detailed (or $SBOT_DESCRIPTION_DIR): " + missing + "detailed.urdf"),
+            std::string::npos) << o.output;
+  o = sbot_test::runProcess(env + "sbot_validate --out " + testing::TempDir() + "cli_no_description --only facts");
+  EXPECT_EQ(o.status, 2) << o.output;
+  EXPECT_NE(o.output.find("sbot_validate: model description of level 'fast' (or $SBOT_DESCRIPTION_DIR): " + missing),
+            std::string::npos) << o.output;
+  o = sbot_test::runProcess(env + "sbot_validate --trial step detailed 0.010");
+  EXPECT_EQ(o.status, 2) << o.output;
+  EXPECT_NE(o.output.find("sbot_validate: --trial step detailed: " + missing + "detailed.urdf"), std::string::npos)
+      << o.output;
 }
 
 TEST(ToolsCli, AValidTrialRuns) {
