@@ -64,8 +64,8 @@ class ControllerOutcome(unittest.TestCase):
                 q = self.pose[robot]
                 self.travel[robot] += math.hypot(p[0] - q[0], p[1] - q[1])
             self.pose[robot] = p
-            q = msg.pose.pose.orientation
-            self.heading[robot] = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
+            o = msg.pose.pose.orientation
+            self.heading[robot] = math.atan2(2 * (o.w * o.z + o.x * o.y), 1 - 2 * (o.y * o.y + o.z * o.z))
             self.t_last = max(self.t_last, t)
             limit = 2 * self.radius - 0.005
             for other, q in self.pose.items():

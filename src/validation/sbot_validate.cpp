@@ -519,7 +519,7 @@ int main(int argc, char** argv) {
         for (int k = 0; k < kRtmRepeats; ++k) {
           const v::Outcome run =
               v::runParallel(1, 1, [&](int) { return v::rtmTrial(level, o.quick ? secs / 3 : secs, with_sensors); })[0];
-          if (run.label != "error" && (fastest.label == "error" || run.value > fastest.value)) fastest = run;
+          if (!failed(run) && (failed(fastest) || run.value > fastest.value)) fastest = run;
         }
         return fastest;
       };
