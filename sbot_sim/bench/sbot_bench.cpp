@@ -144,12 +144,7 @@ void runOne(const Options& o, int n) {
 
 int main(int argc, char** argv) {
   const Options o = parse(argc, argv);
-  try {
-    sbot::loadLevel(o.level);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "sbot_bench: --level: %s\n", e.what());
-    return 2;
-  }
+  sbot_tools::requireLevel("sbot_bench", "--level", o.level);
   std::printf("sbot_bench: headless core, flat arena, random walk, 1 core per run\n");
   std::printf("%-8s %7s %10s %12s %14s %12s\n", "level", "robots", "sim_s", "RTM", "wall_ms/step", "peak_MiB");
   std::fflush(stdout);

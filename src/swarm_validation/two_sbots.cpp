@@ -73,12 +73,7 @@ int main(int argc, char** argv) {
       return a == "--help" ? 0 : 2;
     }
   }
-  try {  // the default level too: an unreadable description aborted the tool at its first trial
-    sbot::loadLevel(level);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "two_sbots: --level %s (or $SBOT_DESCRIPTION_DIR): %s\n", level.c_str(), e.what());
-    return 2;
-  }
+  sbot_tools::requireLevel("two_sbots", "--level " + level + " (or $SBOT_DESCRIPTION_DIR)", level);  // the default too
   const std::string friction = setup.seed_friction ? "seed (force limit 1.2 N per contact)"
                                : "Coulomb (treels mu " + std::to_string(setup.track_mu > 0 ? setup.track_mu : 1.0).substr(0, 4) + ")";
   std::printf("two_sbots: level %s, %d trials per cell, friction %s, %s\n\n", level.c_str(), trials, friction.c_str(),

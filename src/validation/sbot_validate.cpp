@@ -212,12 +212,7 @@ int main(int argc, char** argv) {
       const double p = sbot_tools::numberArg(args.tool(), "--trial " + kind + " " + level, args.value(), -1e6, 1e6);
       v::setTrace(trace);
       Outcome r;
-      try {  // an unknown level or an unreadable description: refused by name, not an abort
-        sbot::loadLevel(level);
-      } catch (const std::exception& e) {
-        std::fprintf(stderr, "sbot_validate: --trial %s %s: %s\n", kind.c_str(), level.c_str(), e.what());
-        return 2;
-      }
+      sbot_tools::requireLevel("sbot_validate", "--trial " + kind + " " + level, level);
       if (kind == "gap") r = v::gapTrial(level, p, 0);
       else if (kind == "step") r = v::stepTrial(level, p, false, 0);
       else if (kind == "stepb") r = v::stepTrial(level, p, true, 0);
@@ -271,15 +266,8 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  for (const std::string& level : kAllLevels) {  // before any work: every trial of that level would fail on it
-    try {
-      sbot::loadLevel(level);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "sbot_validate: model description of level '%s' (or $SBOT_DESCRIPTION_DIR): %s\n",
-                   level.c_str(), e.what());
-      return 2;
-    }
-  }
+  for (const std::string& level : kAllLevels)  // before any work: every trial of that level would fail on it
+    sbot_tools::requireLevel("sbot_validate", "model description of level '" + level + "' (or $SBOT_DESCRIPTION_DIR)", level);
   mkdir(o.out.c_str(), 0755);
   const auto t_start = std::chrono::steady_clock::now();
   auto log = [&](const std::string& s) {

@@ -7,7 +7,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <string>
+
+#include "sbot_sim/core/robot_description.h"
 
 namespace sbot_tools {
 
@@ -31,6 +34,17 @@ inline int countArg(const char* tool, const std::string& option, const std::stri
     std::exit(2);
   }
   return static_cast<int>(v);
+}
+
+/// The model description of `level` loads (an unknown level, or a $SBOT_DESCRIPTION_DIR without it,
+/// would abort the tool at its first trial): else "TOOL: WHAT: why" and exit status 2.
+inline void requireLevel(const char* tool, const std::string& what, const std::string& level) {
+  try {
+    sbot::loadLevel(level);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s: %s\n", tool, what.c_str(), e.what());
+    std::exit(2);
+  }
 }
 
 /// Walks one tool's argv: option() is the next argument, value()/number()/count() the one after it.
