@@ -12,6 +12,14 @@
 //   current sample it already returned waits (up to 1 s wall) for the next sample. A controller's
 //   read-act loop therefore runs once per sample in SIMULATED time, whatever the simulator's
 //   real-time factor. Set SBOT_NO_SAMPLE_WAIT=1 to always return the latest value at once.
+// * Lock-step (the simulator's ~lockstep true, read from /sim/lockstep at initSwarmBot): each time a
+//   getter blocks for a message it tells the simulator so on /sim/controller_sync (the topic, the
+//   stamp it has, the cmd_speed / speaker messages sent so far), and the simulator holds its clock
+//   until that message is read and those commands have arrived (sbot_sim/src/node/lockstep_gate.h).
+//   Every getter also waits for the simulator's <robot>/lockstep_hold of the instant it holds at and
+//   for the messages published up to then (ROS orders messages per topic only). The waits then last
+//   up to 30 s wall instead of 2 s / 1 s (the simulator may be holding for another, slower
+//   controller) and end early when the simulator disconnects.
 // * Setters publish (setSpeed -> cmd_speed, LEDs -> leds via set_leds) or call services (turret,
 //   gripper, side arm, sampling rates). Clamped values are reported through the warning handler,
 //   failures through the error handler (if given; else stderr).
@@ -38,10 +46,12 @@
 #include <ros/ros.h>
 #include <sbot_msgs/Battery.h>
 #include <sbot_msgs/Climate.h>
+#include <sbot_msgs/ControllerSync.h>
 #include <sbot_msgs/GripperState.h>
 #include <sbot_msgs/GroundArray.h>
 #include <sbot_msgs/LedState.h>
 #include <sbot_msgs/LightArray.h>
+#include <sbot_msgs/LockstepHold.h>
 #include <sbot_msgs/ProximityArray.h>
 #include <sbot_msgs/SetGripper.h>
 #include <sbot_msgs/SetLeds.h>
@@ -76,6 +86,52 @@ void report(bool error, const char* fmt, ...) {
   }
 }
 
+std::atomic<bool> g_lockstep{false};  ///< the simulator runs in lock-step with the controllers
+
+/// How long a getter waits for a message: `normal`, or 30 s in lock-step.
+std::chrono::seconds waitLimit(int normal) { return std::chrono::seconds(g_lockstep ? 30 : normal); }
+
+/// Lock-step: tell the simulator this controller now waits for a message on `channel` stamped later
+/// than `after` (defined below, after Api).
+/// `first`: the controller has just subscribed; the connection is awaited first (up to 5 s).
+void announceWait(const std::string& channel, const ros::Time& after, const ros::Subscriber& sub, bool first);
+
+/// Lock-step: where the simulator holds for this controller. A controller runs only while the
+/// simulator holds its clock at `now` for it (it woke on a message stamped `now`); the simulator
+/// then sends a LockstepHold listing what it has published on each topic up to `now`, and every
+/// getter first waits for that, so it returns what was published up to `now` whatever the order in
+/// which the topics' messages arrived.
+struct HoldState {
+  std::mutex m;
+  std::condition_variable cv;
+  ros::Time now;                                   ///< the sim time the controller acts at
+  ros::Time held;                                  ///< stamp of the latest LockstepHold received
+  std::map<std::string, ros::Time> latest;         ///< its topic -> latest stamp published
+  ros::Subscriber sub;                             ///< <robot>/lockstep_hold
+
+  void woke(const ros::Time& t) {
+    std::lock_guard<std::mutex> l(m);
+    if (t > now) now = t;
+  }
+  ros::Time current() {
+    std::lock_guard<std::mutex> l(m);
+    return now;
+  }
+  /// The latest stamp published on `topic` up to `now` (waits for the hold of `now`; 0 = unknown).
+  ros::Time latestOf(const std::string& topic) {
+    std::unique_lock<std::mutex> l(m);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (held < now && ros::ok() && std::chrono::steady_clock::now() < deadline) {
+      cv.wait_for(l, std::chrono::milliseconds(100));
+      if (sub && sub.getNumPublishers() == 0) break;  // the simulator is gone
+    }
+    if (held < now) return ros::Time(0);
+    const auto it = latest.find(topic);
+    return it == latest.end() ? ros::Time(0) : it->second;
+  }
+};
+HoldState g_hold;
+
 /// Latest message of one topic, subscribed on first use, with per-index "already returned" stamps.
 template <class Msg>
 class Latest {
@@ -95,19 +151,21 @@ class Latest {
         cv_.notify_all();
       }, ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
     }
-    if (!has_) cv_.wait_for(lock, std::chrono::seconds(2), [this] { return has_; });
-    if (!has_) return false;
-    if (fresh && sampleWait()) {
-      auto stale = [&] {
-        const ros::Time s = stamp(msg_);
-        if (index == npos) {
-          for (const auto& r : returned_)
-            if (r >= s) return true;
-          return false;
-        }
-        return returned_[index] >= s;
-      };
-      if (stale()) cv_.wait_for(lock, std::chrono::seconds(1), [&] { return !stale() || !ros::ok(); });
+    auto stale = [&] {
+      const ros::Time s = stamp(msg_);
+      if (index == npos) {
+        for (const auto& r : returned_)
+          if (r >= s) return true;
+        return false;
+      }
+      return returned_[index] >= s;
+    };
+    if (g_lockstep) {
+      if (!getInLockstep(lock, fresh && sampleWait(), stale)) return false;
+    } else {
+      if (!has_) waitUntil(lock, 2, [this] { return has_; });
+      if (!has_) return false;
+      if (fresh && sampleWait() && stale()) waitUntil(lock, 1, [&] { return !stale(); });
     }
     const ros::Time s = stamp(msg_);
     if (index == npos) {
@@ -121,6 +179,53 @@ class Latest {
   static constexpr std::size_t npos = static_cast<std::size_t>(-1);
 
  private:
+  /// The lock-step path of get(): a first message published after the controller's present, the
+  /// topic caught up with the simulator's hold, and (fresh) a message newer than the one returned.
+  /// Each wait for a new message is announced, so the simulator steps until it publishes one and
+  /// then holds again.
+  template <class Stale>
+  bool getInLockstep(std::unique_lock<std::mutex>& lock, bool fresh, Stale stale) {
+    if (!has_) {
+      const ros::Time now = g_hold.current();
+      lock.unlock();
+      announceWait(topic_, now, sub_, true);
+      lock.lock();
+      waitUntil(lock, 2, [&] { return has_ && stamp(msg_) > now; });
+      if (!has_) return false;
+      g_hold.woke(stamp(msg_));
+    }
+    catchUp(lock);
+    if (fresh && stale()) {
+      const ros::Time have = stamp(msg_);
+      lock.unlock();
+      announceWait(topic_, have, sub_, false);
+      lock.lock();
+      waitUntil(lock, 1, [&] { return stamp(msg_) > have; });
+      if (stamp(msg_) > have) {
+        g_hold.woke(stamp(msg_));
+        catchUp(lock);
+      }
+    }
+    return true;
+  }
+  /// Wait until this topic's message is the latest the simulator published up to the present.
+  void catchUp(std::unique_lock<std::mutex>& lock) {
+    lock.unlock();
+    const ros::Time need = g_hold.latestOf(topic_);
+    lock.lock();
+    waitUntil(lock, 1, [&] { return stamp(msg_) >= need; });
+  }
+  /// Wait (lock held on entry and exit) until `ready`, ROS shuts down, `normal` seconds pass (30 in
+  /// lock-step), or, in lock-step, the simulator disconnects (so a controller stopped with its
+  /// simulator is not left blocked for the full 30 s).
+  template <class Pred>
+  void waitUntil(std::unique_lock<std::mutex>& lock, int normal, Pred ready) {
+    const auto deadline = Clock::now() + waitLimit(normal);
+    while (!ready() && ros::ok() && Clock::now() < deadline) {
+      cv_.wait_for(lock, std::chrono::milliseconds(100), ready);
+      if (g_lockstep && sub_.getNumPublishers() == 0) break;
+    }
+  }
   static bool sampleWait() {
     static const bool wait = !(std::getenv("SBOT_NO_SAMPLE_WAIT") && std::string(std::getenv("SBOT_NO_SAMPLE_WAIT")) == "1");
     return wait;
@@ -141,6 +246,9 @@ struct Api {
   std::unique_ptr<ros::NodeHandle> nh;
   std::unique_ptr<ros::AsyncSpinner> spinner;
   ros::Publisher speed_pub, speaker_pub;
+  ros::Publisher sync_pub;                  ///< /sim/controller_sync (lock-step only)
+  std::string robot;                        ///< namespace without slashes, e.g. sbot_0
+  std::atomic<std::uint64_t> speed_sent{0}, speaker_sent{0};
   Latest<sbot_msgs::ProximityArray> proximity{"proximity", 15};
   Latest<sbot_msgs::GroundArray> ground{"ground", 4};
   Latest<sbot_msgs::LightArray> light{"light", 8};
@@ -159,6 +267,20 @@ struct Api {
 };
 
 std::unique_ptr<Api> g;
+
+void announceWait(const std::string& channel, const ros::Time& after, const ros::Subscriber& sub, bool first) {
+  if (!g_lockstep || !g) return;
+  // The simulator can only hold for a message it can deliver: wait for the connection first.
+  const auto until = Clock::now() + std::chrono::seconds(5);
+  while (first && sub.getNumPublishers() == 0 && Clock::now() < until && ros::ok()) usleep(1000);
+  sbot_msgs::ControllerSync m;
+  m.robot = g->robot;
+  m.channel = channel;
+  m.after = after;
+  m.speed_commands = g->speed_sent;
+  m.speaker_commands = g->speaker_sent;
+  g->sync_pub.publish(m);
+}
 
 bool ready(const char* fn) {
   if (g && g->nh && ros::ok()) return true;
@@ -281,14 +403,38 @@ void initSwarmBot(void (*errorHandler)(const char*), void (*warningHandler)(cons
   }
   const auto until = Clock::now() + std::chrono::seconds(5);
   while (g->speed_pub.getNumSubscribers() == 0 && Clock::now() < until) usleep(10000);
+  bool lockstep = false;
+  ros::param::param("/sim/lockstep", lockstep, false);
+  if (lockstep) {
+    g->robot = g->nh->getNamespace();
+    while (!g->robot.empty() && g->robot.front() == '/') g->robot.erase(0, 1);
+    g->sync_pub = g->nh->advertise<sbot_msgs::ControllerSync>("/sim/controller_sync", 100);
+    g_hold.sub = g->nh->subscribe<sbot_msgs::LockstepHold>("lockstep_hold", 10, [](const sbot_msgs::LockstepHold::ConstPtr& h) {
+      std::lock_guard<std::mutex> l(g_hold.m);
+      g_hold.held = h->stamp;
+      g_hold.latest.clear();
+      for (std::size_t k = 0; k < h->topics.size() && k < h->latest.size(); ++k) g_hold.latest[h->topics[k]] = h->latest[k];
+      g_hold.cv.notify_all();
+    }, ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+    while ((g->sync_pub.getNumSubscribers() == 0 || g_hold.sub.getNumPublishers() == 0) &&
+           Clock::now() < until + std::chrono::seconds(5))
+      usleep(10000);
+    if (g->sync_pub.getNumSubscribers() == 0 || g_hold.sub.getNumPublishers() == 0)
+      report(false, "initSwarmBot: the simulator runs in lock-step but is not connected on /sim/controller_sync "
+                    "and %s", g_hold.sub.getTopic().c_str());
+    g_lockstep = true;
+  }
 }
 
 void shutdownSwarmBot(void) {
   if (!g) return;
   if (ros::ok()) {
     setSpeed(0, 0);
+    if (g_lockstep) announceWait("", ros::Time(0), ros::Subscriber(), false);  // leaving: stop holding for us
     usleep(100000);
   }
+  g_lockstep = false;
+  g_hold.sub.shutdown();
   g->spinner->stop();
   g.reset();
   ros::shutdown();
@@ -302,6 +448,7 @@ void setSpeed(int left, int right) {
   m.left = static_cast<int16_t>(left < -127 ? -127 : left > 127 ? 127 : left);
   m.right = static_cast<int16_t>(right < -127 ? -127 : right > 127 ? 127 : right);
   g->speed_pub.publish(m);
+  ++g->speed_sent;
 }
 
 void getSpeed(int* left, int* right) {
@@ -537,6 +684,7 @@ void playMusic(const char* filename) {
   std_msgs::Float64 m;
   m.data = 200.0 + static_cast<double>(h % 1800u);
   g->speaker_pub.publish(m);
+  ++g->speaker_sent;
 }
 
 void stopMusic(void) {
@@ -544,6 +692,7 @@ void stopMusic(void) {
   std_msgs::Float64 m;
   m.data = 0;
   g->speaker_pub.publish(m);
+  ++g->speaker_sent;
 }
 
 }  // extern "C"

@@ -1,5 +1,7 @@
 #include "robot_ros_interface.h"
 
+#include "publication_stamps.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -194,6 +196,7 @@ void RobotRosInterface::publishState(const ros::Time& stamp,
     ts.torque_left = static_cast<int16_t>(tl);
     ts.torque_right = static_cast<int16_t>(tr);
     track_state_pub_.publish(ts);
+    publicationStamps().note(name_, "track_state", ts.header.stamp);
   }
 
   if (turret_state_pub_.getNumSubscribers() > 0 && !r.description().turret.joint.empty()) {
@@ -204,6 +207,7 @@ void RobotRosInterface::publishState(const ros::Time& stamp,
     tu.torque = static_cast<int16_t>(r.getTurretRotationTorque());
     tu.angle = r.turretAngle();
     turret_state_pub_.publish(tu);
+    publicationStamps().note(name_, "turret/state", tu.header.stamp);
   }
 
   geometry_msgs::TransformStamped tf;

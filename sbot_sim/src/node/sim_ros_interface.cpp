@@ -60,12 +60,17 @@ bool SimRosInterface::readParams() {
   pnh_.param("paused", params_.paused, false);
   pnh_.param("set_description_params", params_.set_description_params, false);
   pnh_.param("effects", params_.effects, std::string());
+  pnh_.param("lockstep", params_.lockstep.enabled, false);
+  pnh_.param("lockstep_controllers", params_.lockstep.controllers, 0);
+  pnh_.param("lockstep_timeout", params_.lockstep.timeout, 10.0);
   ROS_INFO("simulator: ~scenario=%s ~robots=%d ~level=%s ~real_time_factor=%g ~duration=%g ~publish_rate=%g "
            "~paused=%s ~set_description_params=%s ~effects=%s", params_.scenario.c_str(), params_.robots,
            params_.level.empty() ? "(the scenario's)" : params_.level.c_str(),
            params_.real_time_factor, params_.duration, params_.publish_rate, params_.paused ? "true" : "false",
            params_.set_description_params ? "true" : "false",
            params_.effects.empty() ? "(the scenario's)" : params_.effects.c_str());
+  ROS_INFO("simulator: ~lockstep=%s ~lockstep_controllers=%d ~lockstep_timeout=%g", params_.lockstep.enabled ? "true" : "false",
+           params_.lockstep.controllers, params_.lockstep.timeout);
   const auto& levels = sbot::modelLevels();
   if (!params_.level.empty() && std::find(levels.begin(), levels.end(), params_.level) == levels.end()) {
     ROS_FATAL("simulator: ~level must be fast, simple, basic, medium or detailed (empty: the scenario's levels), "
@@ -85,6 +90,17 @@ bool SimRosInterface::readParams() {
     ROS_FATAL("simulator: ~duration must be >= 0 s (0 = the scenario's), got %g", params_.duration);
     ok = false;
   }
+  if (params_.lockstep.controllers < 0) {
+    ROS_FATAL("simulator: ~lockstep_controllers must be >= 0 (controllers to await before the first step), got %d",
+              params_.lockstep.controllers);
+    ok = false;
+  }
+  if (!std::isfinite(params_.lockstep.timeout) || params_.lockstep.timeout <= 0) {
+    ROS_FATAL("simulator: ~lockstep_timeout must be > 0 s wall, got %g", params_.lockstep.timeout);
+    ok = false;
+  }
+  if (params_.lockstep.controllers > 0 && !params_.lockstep.enabled)
+    ROS_WARN("simulator: ~lockstep_controllers=%d has no effect without ~lockstep true", params_.lockstep.controllers);
   if (!std::isfinite(params_.publish_rate) || params_.publish_rate <= 0) {
     ROS_FATAL("simulator: ~publish_rate must be > 0 Hz, got %g", params_.publish_rate);
     ok = false;
@@ -115,6 +131,8 @@ bool SimRosInterface::init() {
 
   // Every node started after this one follows /clock (the launch files set it too).
   ros::param::set("/use_sim_time", true);
+  // Read by libsbot_ros's initSwarmBot, which waits for the robots' services advertised below.
+  ros::param::set("/sim/lockstep", params_.lockstep.enabled);
 
   clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 1000);
   tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
@@ -122,6 +140,11 @@ bool SimRosInterface::init() {
   swarm_ = std::make_unique<SwarmRosInterface>(nh_, pnh_, world_, robots_, params_.set_description_params);
   for (sbot::Robot* r : world_->robots())
     robots_.push_back(std::make_unique<RobotRosInterface>(nh_, *r, params_.set_description_params));
+  if (params_.lockstep.enabled) {
+    std::vector<std::string> names;
+    for (const auto& r : robots_) names.push_back(r->name());
+    lockstep_ = std::make_unique<LockstepGate>(nh_, params_.lockstep, names);
+  }
   bool modules = true;  // ~modules: false = no sensor/actuator modules (benchmarking the bare node)
   pnh_.param("modules", modules, true);
   if (modules) {
@@ -259,6 +282,10 @@ int SimRosInterface::run() {
     }
     queue->callAvailable();  // commands received so far apply at this step
     if (paused_ || !ros::ok()) continue;
+    if (lockstep_ && !lockstep_->mayStep()) {
+      queue->callAvailable(ros::WallDuration(0.002));  // a controller is reading or sending
+      continue;
+    }
     try {
       stepOnce();
     } catch (const std::exception& e) {
@@ -283,11 +310,13 @@ void SimRosInterface::logSummary(const std::string& reason) const {
                 running > 1e-9 ? sim / running : 0.0, robots_.size(),
                 static_cast<unsigned long long>(total_steps_ - reset_count_),  // a reset counts one step
                 static_cast<unsigned long long>(reset_count_));
+  std::string text = line;
+  if (lockstep_) text += "; " + lockstep_->summary();
   if (ros::ok()) {
-    ROS_INFO("%s", line);
+    ROS_INFO("%s", text.c_str());
   } else {
     // Shut down from outside (rosnode kill, master gone): rosconsole no longer prints.
-    std::printf("[ INFO] %s\n", line);
+    std::printf("[ INFO] %s\n", text.c_str());
     std::fflush(stdout);
   }
 }

@@ -19,6 +19,7 @@
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/transform_broadcaster.h>
 
+#include "lockstep_gate.h"
 #include "marker_publisher.h"
 #include "robot_ros_interface.h"
 #include "swarm_ros_interface.h"
@@ -39,6 +40,7 @@ struct NodeParams {
   std::string effects;           ///< ~effects: effects file (sbot_calibrate fit); replaces the scenario's `effects`
   /// ~set_description_params: also set <robot>/robot_description and <robot>/tf_prefix
   bool set_description_params = false;
+  LockstepParams lockstep;       ///< ~lockstep, ~lockstep_controllers, ~lockstep_timeout (lockstep_gate.h)
 };
 
 class SimRosInterface {
@@ -106,6 +108,8 @@ class SimRosInterface {
   std::unique_ptr<SwarmRosInterface> swarm_;
   /// Sensors and actuator modules of every robot (+ /sim/set_lamp, /sim/set_ambient_light)
   std::unique_ptr<ModulesRosInterface> modules_;
+  /// Holds the clock for the sbot.h controllers (~lockstep); null when off
+  std::unique_ptr<LockstepGate> lockstep_;
   ros::ServiceServer pause_srv_, unpause_srv_, reset_srv_, step_srv_, set_pose_srv_;
 };
 

@@ -1,0 +1,167 @@
+#include "lockstep_gate.h"
+
+#include <cstdio>
+
+#include <sbot_msgs/TrackSpeed.h>
+#include <std_msgs/Float64.h>
+
+#include "publication_stamps.h"
+
+namespace sbot_node {
+
+namespace {
+
+using SteadyClock = std::chrono::steady_clock;
+
+double secondsBetween(SteadyClock::time_point a, SteadyClock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+/// The topics libsbot_ros's getters read (sbot_controllers/src/sbot_ros.cpp, class Latest), whose
+/// publishers note their stamps in publicationStamps().
+const std::set<std::string>& trackedChannels() {
+  static const std::set<std::string> channels = {"proximity", "ground", "light", "slope", "battery", "climate",
+                                                 "track_state", "turret/state", "gripper/state", "side_arm/state"};
+  return channels;
+}
+
+}  // namespace
+
+LockstepGate::LockstepGate(ros::NodeHandle& nh, const LockstepParams& params, const std::vector<std::string>& robots)
+    : nh_(nh), params_(params) {
+  for (const std::string& r : robots) attachRobot(r);
+  sync_sub_ = nh_.subscribe("/sim/controller_sync", 100, &LockstepGate::onSync, this,
+                            ros::TransportHints().tcpNoDelay());
+  last_waiting_log_ = SteadyClock::now();
+}
+
+void LockstepGate::onSync(const sbot_msgs::ControllerSync::ConstPtr& msg) {
+  const std::string& robot = msg->robot;
+  if (robot.empty() || robot.find('/') != std::string::npos) {
+    ROS_WARN("simulator: lockstep: ignoring a controller sync with robot '%s' (expected a namespace such as sbot_0)",
+             robot.c_str());
+    return;
+  }
+  if (msg->channel.empty()) {  // the controller is leaving (shutdownSwarmBot)
+    if (waiting_.erase(robot)) ROS_INFO("simulator: lockstep: the controller of %s left", robot.c_str());
+    return;
+  }
+  if (announced_.insert(robot).second) {
+    if (!received_.count(robot)) {
+      // A robot spawned after the start: what its controller sent before now is taken as arrived.
+      attachRobot(robot);
+      received_[robot].speed = msg->speed_commands;
+      received_[robot].speaker = msg->speaker_commands;
+    }
+    ROS_INFO("simulator: lockstep: the controller of %s joined (%zu of %d awaited)", robot.c_str(),
+             announced_.size(), params_.controllers);
+  }
+  watch(robot, msg->channel);
+  waiting_[robot] = Waiter{*msg, SteadyClock::now()};
+}
+
+void LockstepGate::attachRobot(const std::string& robot) {
+  Received& r = received_[robot];
+  r.hold_pub = nh_.advertise<sbot_msgs::LockstepHold>("/" + robot + "/lockstep_hold", 10, /*latch=*/true);
+  const std::string ns = "/" + robot + "/";
+  // Counted beside the robot interface's own subscriptions: one connection delivers to both.
+  r.subs.push_back(nh_.subscribe<sbot_msgs::TrackSpeed>(ns + "cmd_speed", 100,
+      [this, robot](const sbot_msgs::TrackSpeed::ConstPtr&) { ++received_[robot].speed; }));
+  r.subs.push_back(nh_.subscribe<std_msgs::Float64>(ns + "speaker", 100,
+      [this, robot](const std_msgs::Float64::ConstPtr&) { ++received_[robot].speaker; }));
+}
+
+void LockstepGate::watch(const std::string& robot, const std::string& channel) {
+  if (!watched_.insert(robot + "/" + channel).second) return;
+  if (!trackedChannels().count(channel)) {
+    if (unknown_channels_.insert(channel).second)
+      ROS_WARN("simulator: lockstep: a controller waits on '%s', which the simulator does not track; "
+               "it is not held for (known: proximity, ground, light, slope, battery, climate, track_state, "
+               "turret/state, gripper/state, side_arm/state)", channel.c_str());
+    return;
+  }
+  received_[robot].channels.push_back(channel);
+}
+
+void LockstepGate::publishHold(const std::string& robot, const ros::Time& stamp) {
+  Received& r = received_[robot];
+  if (r.hold_sent >= stamp) return;
+  r.hold_sent = stamp;
+  sbot_msgs::LockstepHold h;
+  h.stamp = stamp;
+  for (const std::string& c : r.channels) {
+    h.topics.push_back(c);
+    h.latest.push_back(publicationStamps().latest(robot, c));
+  }
+  r.hold_pub.publish(h);
+}
+
+std::string LockstepGate::holdReason(const Waiter& w) const {
+  const sbot_msgs::ControllerSync& s = w.sync;
+  const auto r = received_.find(s.robot);
+  const std::uint64_t speed = r == received_.end() ? 0 : r->second.speed;
+  const std::uint64_t speaker = r == received_.end() ? 0 : r->second.speaker;
+  char why[256];
+  if (speed < s.speed_commands || speaker < s.speaker_commands) {
+    std::snprintf(why, sizeof(why), "commands in flight (cmd_speed %llu of %llu, speaker %llu of %llu received)",
+                  static_cast<unsigned long long>(speed), static_cast<unsigned long long>(s.speed_commands),
+                  static_cast<unsigned long long>(speaker), static_cast<unsigned long long>(s.speaker_commands));
+    return why;
+  }
+  const ros::Time published = publicationStamps().latest(s.robot, s.channel);
+  if (published > s.after) {
+    std::snprintf(why, sizeof(why), "has %s stamped %.3f s to read (it last read %.3f s)", s.channel.c_str(),
+                  published.toSec(), s.after.toSec());
+    return why;
+  }
+  return "";
+}
+
+bool LockstepGate::mayStep() {
+  const auto now = SteadyClock::now();
+  bool hold = static_cast<int>(announced_.size()) < params_.controllers;
+  if (hold && secondsBetween(last_waiting_log_, now) > 5.0) {
+    last_waiting_log_ = now;
+    std::string joined;
+    for (const std::string& r : announced_) joined += (joined.empty() ? "" : ", ") + r;
+    ROS_WARN("simulator: lockstep: not stepping until %d controllers have announced themselves (~lockstep_controllers); "
+             "%zu so far (%s)", params_.controllers, announced_.size(), joined.empty() ? "none" : joined.c_str());
+  }
+  for (auto it = waiting_.begin(); it != waiting_.end();) {
+    const std::string why = holdReason(it->second);
+    if (why.empty()) {
+      ++it;
+      continue;
+    }
+    if (secondsBetween(it->second.since, now) > params_.timeout) {
+      ROS_WARN("simulator: lockstep: dropping the controller of %s: no sync for %.1f s wall while it %s; "
+               "the simulation no longer waits for it (~lockstep_timeout %.1f s)", it->first.c_str(),
+               secondsBetween(it->second.since, now), why.c_str(), params_.timeout);
+      ++dropped_;
+      it = waiting_.erase(it);
+      continue;
+    }
+    hold = true;
+    // Holding for a new message: the controller wakes at its stamp and acts there.
+    const ros::Time published = publicationStamps().latest(it->first, it->second.sync.channel);
+    if (published > it->second.sync.after) publishHold(it->first, published);
+    ++it;
+  }
+  if (hold && !was_holding_) {
+    hold_start_ = now;
+    ++holds_;
+  } else if (!hold && was_holding_) {
+    held_wall_ += secondsBetween(hold_start_, now);
+  }
+  was_holding_ = hold;
+  return !hold;
+}
+
+std::string LockstepGate::summary() const {
+  char line[200];
+  std::snprintf(line, sizeof(line), "lockstep: %zu controllers, held %llu times for %.2f s wall, %d dropped",
+                announced_.size(), static_cast<unsigned long long>(holds_), held_wall_, dropped_);
+  return line;
+}
+
+}  // namespace sbot_node

@@ -1,0 +1,95 @@
+// Lock-step with the sbot.h controllers (~lockstep true): the simulator holds its clock while a
+// controller has not yet read the sensor message it is waiting for, or its commands are still in
+// flight, so a run with ROS-node controllers is repeatable whatever the machine's load.
+//
+// Protocol (sbot_msgs/ControllerSync on /sim/controller_sync, sent by libsbot_ros whenever a getter
+// blocks): "robot R waits for a message on R/<channel> stamped later than <after>; it has published
+// <speed_commands> cmd_speed and <speaker_commands> speaker messages so far". The gate listens to the
+// commands inside the simulator (a subscriber of cmd_speed receives exactly what the robot interface
+// applied), reads what the node published from publicationStamps(), and:
+//   * holds while fewer than ~lockstep_controllers controllers have announced themselves;
+//   * holds while the simulator has published R/<channel> later than <after> (the controller has a
+//     message to read and will answer with a new sync), or fewer commands have arrived than the
+//     controller says it sent (ROS orders messages per topic, not across topics);
+//   * when it starts holding for a new message, tells the controller on R/lockstep_hold
+//     (sbot_msgs/LockstepHold) what it has published on each topic the controller reads up to then:
+//     the controller's getters wait for exactly that, whatever order the topics' messages arrive in;
+//   * drops a controller that holds the clock for ~lockstep_timeout wall seconds without a new sync
+//     (crashed, or busy-looping without reading a sensor), with a warning naming it.
+// Between two sensor messages the controllers are blocked and the simulator runs freely, so every
+// command a controller computes from the message stamped t applies at the first step after t.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <ros/ros.h>
+#include <sbot_msgs/ControllerSync.h>
+#include <sbot_msgs/LockstepHold.h>
+
+namespace sbot_node {
+
+struct LockstepParams {
+  bool enabled = false;     ///< ~lockstep
+  int controllers = 0;      ///< ~lockstep_controllers: announcements awaited before the first step
+  double timeout = 10.0;    ///< ~lockstep_timeout [s wall]: a controller holding longer is dropped
+};
+
+class LockstepGate {
+ public:
+  /// `robots`: the robots present at start; their commands are counted from now on, before any
+  /// controller connects.
+  LockstepGate(ros::NodeHandle& nh, const LockstepParams& params, const std::vector<std::string>& robots);
+
+  /// May the simulator take its next step? Call after serving the callback queue.
+  bool mayStep();
+
+  /// For the run summary, e.g. "lockstep: 3 controllers, held 1200 times for 4.2 s wall, 0 dropped".
+  std::string summary() const;
+
+ private:
+  struct Waiter {
+    sbot_msgs::ControllerSync sync;
+    std::chrono::steady_clock::time_point since;  ///< when this sync arrived
+  };
+  struct Received {
+    std::uint64_t speed = 0, speaker = 0;
+    std::vector<ros::Subscriber> subs;
+    std::vector<std::string> channels;  ///< watched topics under the robot
+    ros::Publisher hold_pub;            ///< <robot>/lockstep_hold (latched)
+    ros::Time hold_sent;                ///< stamp of the last hold told
+  };
+
+  void onSync(const sbot_msgs::ControllerSync::ConstPtr& msg);
+  /// Count the cmd_speed and speaker messages that reach `robot` and advertise its lockstep_hold
+  /// (once per robot).
+  void attachRobot(const std::string& robot);
+  /// Tell the controller of `robot` that the simulator holds at `stamp`.
+  void publishHold(const std::string& robot, const ros::Time& stamp);
+  /// Include robot/channel in the robot's holds (once); warn about a topic the node does not track.
+  void watch(const std::string& robot, const std::string& channel);
+  /// Why the controller of `w` holds the clock ("" = it does not).
+  std::string holdReason(const Waiter& w) const;
+
+  ros::NodeHandle nh_;
+  LockstepParams params_;
+  ros::Subscriber sync_sub_;
+  std::map<std::string, Waiter> waiting_;             ///< robot -> its controller's last sync
+  std::map<std::string, Received> received_;          ///< robot -> commands received, listeners
+  std::set<std::string> watched_;                     ///< "robot/channel" listened to
+  std::set<std::string> announced_;                   ///< robots whose controller ever synced
+  std::set<std::string> unknown_channels_;            ///< warned once each
+  bool was_holding_ = false;
+  std::chrono::steady_clock::time_point hold_start_;
+  std::uint64_t holds_ = 0;
+  double held_wall_ = 0;
+  int dropped_ = 0;
+  std::chrono::steady_clock::time_point last_waiting_log_;
+};
+
+}  // namespace sbot_node

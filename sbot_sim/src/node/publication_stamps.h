@@ -1,0 +1,36 @@
+// The stamp of the latest message the simulator node published on each robot topic that sbot.h
+// getters read (proximity, turret/state, ...), noted by the publishers themselves. The lock-step
+// gate (lockstep_gate.h) reads it: a subscription of the node to its own topics would connect
+// asynchronously and miss the first messages after it is made. The node is single-threaded
+// (sim_ros_interface.h), so there is no locking.
+#pragma once
+
+#include <map>
+#include <string>
+
+#include <ros/time.h>
+
+namespace sbot_node {
+
+class PublicationStamps {
+ public:
+  void note(const std::string& robot, const std::string& topic, const ros::Time& stamp) {
+    latest_[robot + "/" + topic] = stamp;
+  }
+  /// 0 when nothing was published on robot/topic.
+  ros::Time latest(const std::string& robot, const std::string& topic) const {
+    const auto it = latest_.find(robot + "/" + topic);
+    return it == latest_.end() ? ros::Time(0) : it->second;
+  }
+
+ private:
+  std::map<std::string, ros::Time> latest_;
+};
+
+/// The node's one record.
+inline PublicationStamps& publicationStamps() {
+  static PublicationStamps stamps;
+  return stamps;
+}
+
+}  // namespace sbot_node

@@ -1,0 +1,126 @@
+#!/usr/bin/python3
+"""Lock-step makes a run with sbot.h controllers repeatable, and a dead controller does not stop it.
+
+Runs launch/sbot_api_phototaxis.launch (3 Medium s-bots, one phototaxis controller process each)
+twice with lockstep:=true, as fast as possible, each with its own ROS master on a free port, records
+/swarm/graph, and checks that the robots' positions agree at every common stamp (to 1e-9 m) and that
+the robots moved. Without lock-step the controllers answer a varying number of steps late and the
+two runs differ (see the README, "Lock-step"). A third run freezes one controller (SIGSTOP, as a
+hung controller or a debugger would) in the middle: the simulator drops it after ~lockstep_timeout
+and finishes the run. (A controller that dies outright unsubscribes, so nothing is held for it.)
+"""
+import os
+import signal
+import socket
+import subprocess
+import tempfile
+import time
+import unittest
+
+import rosbag
+
+SIM_SECONDS = 20.0
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def launch_phototaxis(env, *args):
+    return subprocess.Popen(["roslaunch", "-p", env["ROS_MASTER_URI"].rsplit(":", 1)[1], "swarmbot3d",
+                             "sbot_api_phototaxis.launch"] + list(args),
+                            env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+
+
+def controller_pid(namespace):
+    """The pid of the sbot_phototaxis process roslaunch started in `namespace` (ROS_NAMESPACE)."""
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open("/proc/%s/cmdline" % pid, "rb") as f:
+                if b"sbot_phototaxis" not in f.read():
+                    continue
+            with open("/proc/%s/environ" % pid, "rb") as f:
+                if b"ROS_NAMESPACE=" + namespace.encode() + b"\0" in f.read() + b"\0":
+                    return int(pid)
+        except OSError:
+            continue
+    return None
+
+
+def run_once(workdir, tag, lockstep=True):
+    """One launch; returns ({stamp: [(x, y), ...]}, the simulator's summary line)."""
+    port = free_port()
+    env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % port)
+    bag = os.path.join(workdir, tag + ".bag")
+    launch = launch_phototaxis(env, "lockstep:=%s" % ("true" if lockstep else "false"),
+                               "duration:=%g" % SIM_SECONDS, "real_time_factor:=0")
+    recorder = None
+    try:
+        # The simulator waits for its three controllers before the first step; the recorder is
+        # usually subscribed by then, and only stamps present in both runs are compared anyway.
+        recorder = subprocess.Popen(["rosbag", "record", "-q", "-O", bag, "/swarm/graph"], env=env,
+                                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        out, _ = launch.communicate(timeout=180)
+    finally:
+        if launch.poll() is None:
+            launch.kill()
+        if recorder is not None:
+            recorder.send_signal(subprocess.signal.SIGINT)
+            recorder.wait(timeout=30)
+    summary = [l for l in out.splitlines() if "duration reached" in l]
+    positions = {}
+    with rosbag.Bag(bag) as b:
+        for _, m, _ in b.read_messages(topics=["/swarm/graph"]):
+            positions[round(m.header.stamp.to_sec(), 3)] = [(p.x, p.y) for p in m.positions]
+    return positions, (summary[0] if summary else out[-3000:])
+
+
+class LockstepRepeatable(unittest.TestCase):
+    def test_two_lockstep_runs_agree(self):
+        with tempfile.TemporaryDirectory() as d:
+            a, summary_a = run_once(d, "a")
+            b, summary_b = run_once(d, "b")
+        for s in (summary_a, summary_b):
+            self.assertRegex(s, r"duration reached", s)
+            self.assertRegex(s, r"lockstep: 3 controllers, held \d+ times .* 0 dropped", s)
+        common = sorted(set(a) & set(b))
+        self.assertGreater(len(common), 100, "too few common /swarm/graph stamps: %d" % len(common))
+        self.assertGreaterEqual(common[-1], SIM_SECONDS - 0.5)
+        worst = max(abs(pa[k] - pb[k]) for t in common for pa, pb in zip(a[t], b[t]) for k in (0, 1))
+        first, last = a[common[0]], a[common[-1]]
+        moved = min(((l[0] - f[0]) ** 2 + (l[1] - f[1]) ** 2) ** 0.5 for f, l in zip(first, last))
+        print("lockstep: %d common stamps %.1f-%.1f s, largest position difference %.3g m, least moved %.2f m"
+              % (len(common), common[0], common[-1], worst, moved))
+        self.assertLess(worst, 1e-9, "the two lock-step runs differ")
+        self.assertGreater(moved, 0.2, "the robots hardly moved: the comparison would prove nothing")
+
+    def test_a_hung_controller_is_dropped_and_the_run_goes_on(self):
+        env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % free_port())
+        # 10 s simulated at twice real time: the kill lands in the middle of the run.
+        launch = launch_phototaxis(env, "lockstep:=true", "lockstep_timeout:=1", "duration:=10",
+                                   "real_time_factor:=2")
+        try:
+            deadline = time.monotonic() + 30
+            pid = None
+            while pid is None and time.monotonic() < deadline:
+                pid = controller_pid("/sbot_2")
+                time.sleep(0.1)
+            self.assertIsNotNone(pid, "no sbot_phototaxis process in /sbot_2")
+            time.sleep(4.0)  # started, joined, running
+            os.kill(pid, signal.SIGSTOP)
+            time.sleep(3.0)  # > ~lockstep_timeout: dropped by now
+            os.kill(pid, signal.SIGKILL)
+            out, _ = launch.communicate(timeout=120)
+        finally:
+            if launch.poll() is None:
+                launch.kill()
+        self.assertIn("dropping the controller of sbot_2", out, out[-3000:])
+        summary = [l for l in out.splitlines() if "duration reached" in l]
+        self.assertEqual(len(summary), 1, out[-3000:])
+        self.assertRegex(summary[0], r"lockstep: 3 controllers, held \d+ times .* 1 dropped")
+
+
+if __name__ == "__main__":
+    unittest.main()
