@@ -27,6 +27,7 @@
 //   time), at 200 + (FNV-1a hash of the filename mod 1800) Hz, so different files are
 //   distinguishable by the sound sensors; stopMusic() silences it.
 #include "sbot.h"
+#include "sbot_controllers/lockstep_client.h"
 
 #include <unistd.h>
 
@@ -46,7 +47,6 @@
 #include <ros/ros.h>
 #include <sbot_msgs/Battery.h>
 #include <sbot_msgs/Climate.h>
-#include <sbot_msgs/ControllerSync.h>
 #include <sbot_msgs/GripperState.h>
 #include <sbot_msgs/GroundArray.h>
 #include <sbot_msgs/LedState.h>
@@ -246,8 +246,7 @@ struct Api {
   std::unique_ptr<ros::NodeHandle> nh;
   std::unique_ptr<ros::AsyncSpinner> spinner;
   ros::Publisher speed_pub, speaker_pub;
-  ros::Publisher sync_pub;                  ///< /sim/controller_sync (lock-step only)
-  std::string robot;                        ///< namespace without slashes, e.g. sbot_0
+  std::unique_ptr<sbot_controllers::LockstepClient> lockstep;  ///< /sim/controller_sync
   std::atomic<std::uint64_t> speed_sent{0}, speaker_sent{0};
   Latest<sbot_msgs::ProximityArray> proximity{"proximity", 15};
   Latest<sbot_msgs::GroundArray> ground{"ground", 4};
@@ -273,13 +272,10 @@ void announceWait(const std::string& channel, const ros::Time& after, const ros:
   // The simulator can only hold for a message it can deliver: wait for the connection first.
   const auto until = Clock::now() + std::chrono::seconds(5);
   while (first && sub.getNumPublishers() == 0 && Clock::now() < until && ros::ok()) usleep(1000);
-  sbot_msgs::ControllerSync m;
-  m.robot = g->robot;
-  m.channel = channel;
-  m.after = after;
-  m.speed_commands = g->speed_sent;
-  m.speaker_commands = g->speaker_sent;
-  g->sync_pub.publish(m);
+  if (channel.empty())
+    g->lockstep->leaving();
+  else
+    g->lockstep->waitingFor(channel, after, g->speed_sent, g->speaker_sent);
 }
 
 bool ready(const char* fn) {
@@ -403,12 +399,8 @@ void initSwarmBot(void (*errorHandler)(const char*), void (*warningHandler)(cons
   }
   const auto until = Clock::now() + std::chrono::seconds(5);
   while (g->speed_pub.getNumSubscribers() == 0 && Clock::now() < until) usleep(10000);
-  bool lockstep = false;
-  ros::param::param("/sim/lockstep", lockstep, false);
-  if (lockstep) {
-    g->robot = g->nh->getNamespace();
-    while (!g->robot.empty() && g->robot.front() == '/') g->robot.erase(0, 1);
-    g->sync_pub = g->nh->advertise<sbot_msgs::ControllerSync>("/sim/controller_sync", 100);
+  g->lockstep = std::make_unique<sbot_controllers::LockstepClient>(*g->nh);
+  if (g->lockstep->enabled()) {
     g_hold.sub = g->nh->subscribe<sbot_msgs::LockstepHold>("lockstep_hold", 10, [](const sbot_msgs::LockstepHold::ConstPtr& h) {
       std::lock_guard<std::mutex> l(g_hold.m);
       g_hold.held = h->stamp;
@@ -416,10 +408,8 @@ void initSwarmBot(void (*errorHandler)(const char*), void (*warningHandler)(cons
       for (std::size_t k = 0; k < h->topics.size() && k < h->latest.size(); ++k) g_hold.latest[h->topics[k]] = h->latest[k];
       g_hold.cv.notify_all();
     }, ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
-    while ((g->sync_pub.getNumSubscribers() == 0 || g_hold.sub.getNumPublishers() == 0) &&
-           Clock::now() < until + std::chrono::seconds(5))
-      usleep(10000);
-    if (g->sync_pub.getNumSubscribers() == 0 || g_hold.sub.getNumPublishers() == 0)
+    while (g_hold.sub.getNumPublishers() == 0 && Clock::now() < until + std::chrono::seconds(5)) usleep(10000);
+    if (!g->lockstep->connected() || g_hold.sub.getNumPublishers() == 0)
       report(false, "initSwarmBot: the simulator runs in lock-step but is not connected on /sim/controller_sync "
                     "and %s", g_hold.sub.getTopic().c_str());
     g_lockstep = true;

@@ -1,10 +1,11 @@
 #!/usr/bin/python3
-"""Lock-step makes a run with sbot.h controllers repeatable, and a dead controller does not stop it.
+"""Lock-step makes a run with controller nodes repeatable, and a hung controller does not stop it.
 
 Runs launch/sbot_api_phototaxis.launch (3 Medium s-bots, one phototaxis controller process each)
 twice with lockstep:=true, as fast as possible, each with its own ROS master on a free port, records
 /swarm/graph, and checks that the robots' positions agree at every common stamp (to 1e-9 m) and that
-the robots moved. Without lock-step the controllers answer a varying number of steps late and the
+the robots moved. The same for swarm.launch (5 Simple s-bots, one random_walk node each, recorded
+by the launch's own rosbag). Without lock-step the controllers answer a varying number of steps late and the
 two runs differ (see the README, "Lock-step"). A third run freezes one controller (SIGSTOP, as a
 hung controller or a debugger would) in the middle: the simulator drops it after ~lockstep_timeout
 and finishes the run. (A controller that dies outright unsubscribes, so nothing is held for it.)
@@ -120,6 +121,39 @@ class LockstepRepeatable(unittest.TestCase):
         summary = [l for l in out.splitlines() if "duration reached" in l]
         self.assertEqual(len(summary), 1, out[-3000:])
         self.assertRegex(summary[0], r"lockstep: 3 controllers, held \d+ times .* 1 dropped")
+
+    def test_two_lockstep_swarm_runs_agree(self):
+        def run(workdir, tag):
+            env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % free_port())
+            bag = os.path.join(workdir, tag + ".bag")
+            p = subprocess.run(["roslaunch", "-p", env["ROS_MASTER_URI"].rsplit(":", 1)[1], "swarmbot3d", "swarm.launch",
+                                "robots:=5", "lockstep:=true", "record:=true", "bag:=" + bag, "duration:=20",
+                                "publish_rate:=20"],
+                               env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=180)
+            summary = [l for l in p.stdout.splitlines() if "duration reached" in l]
+            self.assertEqual(len(summary), 1, p.stdout[-3000:])
+            self.assertRegex(summary[0], r"lockstep: 5 controllers, held \d+ times .* 0 dropped")
+            poses = {}
+            with rosbag.Bag(bag) as b:
+                for topic, m, _ in b.read_messages(topics=["/sbot_%d/ground_truth" % i for i in range(5)]):
+                    poses[(topic, round(m.header.stamp.to_sec(), 3))] = (m.pose.pose.position.x, m.pose.pose.position.y)
+            return poses
+
+        with tempfile.TemporaryDirectory() as d:
+            a, b = run(d, "a"), run(d, "b")
+        common = set(a) & set(b)
+        # rosbag may drop some of the 5 x 20 Hz x 20 s ground-truth messages; most are in both runs.
+        self.assertGreater(len(common), 0.5 * 5 * 20 * 20, "too few common ground-truth samples: %d" % len(common))
+        worst = max(abs(a[k][i] - b[k][i]) for k in common for i in (0, 1))
+        ends = {}
+        for (topic, t), p in sorted(a.items(), key=lambda kv: kv[0][1]):
+            ends.setdefault(topic, [p, p])[1] = p
+        moved = sum(((e[1][0] - e[0][0]) ** 2 + (e[1][1] - e[0][1]) ** 2) ** 0.5 for e in ends.values()) / len(ends)
+        print("lockstep swarm: %d common ground-truth samples, largest difference %.3g m, mean displacement %.2f m"
+              % (len(common), worst, moved))
+        self.assertEqual(len(ends), 5)
+        self.assertLess(worst, 1e-9, "the two lock-step swarm runs differ")
+        self.assertGreater(moved, 0.3, "the robots hardly moved: the comparison would prove nothing")
 
 
 if __name__ == "__main__":

@@ -17,11 +17,12 @@ double secondsBetween(SteadyClock::time_point a, SteadyClock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
 }
 
-/// The topics libsbot_ros's getters read (sbot_controllers/src/sbot_ros.cpp, class Latest), whose
-/// publishers note their stamps in publicationStamps().
+/// The topics libsbot_ros's getters read (sbot_controllers/src/sbot_ros.cpp, class Latest), and
+/// ground_truth (random_walk_node), whose publishers note their stamps in publicationStamps().
 const std::set<std::string>& trackedChannels() {
   static const std::set<std::string> channels = {"proximity", "ground", "light", "slope", "battery", "climate",
-                                                 "track_state", "turret/state", "gripper/state", "side_arm/state"};
+                                                 "track_state", "turret/state", "gripper/state", "side_arm/state",
+                                                 "ground_truth"};
   return channels;
 }
 
@@ -77,7 +78,7 @@ void LockstepGate::watch(const std::string& robot, const std::string& channel) {
     if (unknown_channels_.insert(channel).second)
       ROS_WARN("simulator: lockstep: a controller waits on '%s', which the simulator does not track; "
                "it is not held for (known: proximity, ground, light, slope, battery, climate, track_state, "
-               "turret/state, gripper/state, side_arm/state)", channel.c_str());
+               "turret/state, gripper/state, side_arm/state, ground_truth)", channel.c_str());
     return;
   }
   received_[robot].channels.push_back(channel);

@@ -167,6 +167,7 @@ void RobotRosInterface::publishState(const ros::Time& stamp,
     odom.twist.twist.linear = toVector3(q_inv * v_world);
     odom.twist.twist.angular = toVector3(q_inv * r.angularVelocity());
     ground_truth_pub_.publish(odom);
+    publicationStamps().note(name_, "ground_truth", odom.header.stamp);
   }
 
   if (joint_states_pub_.getNumSubscribers() > 0) {
