@@ -75,10 +75,12 @@ void LockstepGate::attachRobot(const std::string& robot) {
 void LockstepGate::watch(const std::string& robot, const std::string& channel) {
   if (!watched_.insert(robot + "/" + channel).second) return;
   if (!trackedChannels().count(channel)) {
-    if (unknown_channels_.insert(channel).second)
+    if (unknown_channels_.insert(channel).second) {
+      std::string known;
+      for (const std::string& c : trackedChannels()) known += (known.empty() ? "" : ", ") + c;
       ROS_WARN("simulator: lockstep: a controller waits on '%s', which the simulator does not track; "
-               "it is not held for (known: proximity, ground, light, slope, battery, climate, track_state, "
-               "turret/state, gripper/state, side_arm/state, ground_truth)", channel.c_str());
+               "it is not held for (known: %s)", channel.c_str(), known.c_str());
+    }
     return;
   }
   received_[robot].channels.push_back(channel);
