@@ -1,6 +1,7 @@
 #include "lockstep_gate.h"
 
 #include <cstdio>
+#include <utility>
 
 #include <sbot_msgs/TrackSpeed.h>
 #include <std_msgs/Float64.h>
@@ -28,8 +29,9 @@ const std::set<std::string>& trackedChannels() {
 
 }  // namespace
 
-LockstepGate::LockstepGate(ros::NodeHandle& nh, const LockstepParams& params, const std::vector<std::string>& robots)
-    : nh_(nh), params_(params) {
+LockstepGate::LockstepGate(ros::NodeHandle& nh, const LockstepParams& params, const std::vector<std::string>& robots,
+                           RobotCheck check)
+    : nh_(nh), params_(params), check_(std::move(check)) {
   for (const std::string& r : robots) attachRobot(r);
   sync_sub_ = nh_.subscribe("/sim/controller_sync", 100, &LockstepGate::onSync, this,
                             ros::TransportHints().tcpNoDelay());
@@ -38,9 +40,12 @@ LockstepGate::LockstepGate(ros::NodeHandle& nh, const LockstepParams& params, co
 
 void LockstepGate::onSync(const sbot_msgs::ControllerSync::ConstPtr& msg) {
   const std::string& robot = msg->robot;
-  if (robot.empty() || robot.find('/') != std::string::npos) {
-    ROS_WARN("simulator: lockstep: ignoring a controller sync with robot '%s' (expected a namespace such as sbot_0)",
-             robot.c_str());
+  const std::string refused = robot.empty() || robot.find('/') != std::string::npos
+                                  ? "robot '" + robot + "' is not a robot namespace such as sbot_0"
+                                  : check_(robot);
+  if (!refused.empty()) {
+    if (refused_.insert(robot).second)
+      ROS_WARN("simulator: lockstep: ignoring the syncs of a controller: %s", refused.c_str());
     return;
   }
   if (msg->channel.empty()) {  // the controller is leaving (shutdownSwarmBot)

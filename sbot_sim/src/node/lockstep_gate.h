@@ -22,6 +22,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <set>
@@ -42,9 +43,14 @@ struct LockstepParams {
 
 class LockstepGate {
  public:
+  /// Why a robot name is not in the simulation ("" when it is), e.g. "unknown robot 'sbot_99' (robots:
+  /// sbot_0..sbot_2)".
+  using RobotCheck = std::function<std::string(const std::string& robot)>;
+
   /// `robots`: the robots present at start; their commands are counted from now on, before any
-  /// controller connects.
-  LockstepGate(ros::NodeHandle& nh, const LockstepParams& params, const std::vector<std::string>& robots);
+  /// controller connects. `check`: syncs naming a robot it refuses are ignored, with a warning.
+  LockstepGate(ros::NodeHandle& nh, const LockstepParams& params, const std::vector<std::string>& robots,
+               RobotCheck check);
 
   /// May the simulator take its next step? Call after serving the callback queue.
   bool mayStep();
@@ -78,6 +84,8 @@ class LockstepGate {
 
   ros::NodeHandle nh_;
   LockstepParams params_;
+  RobotCheck check_;
+  std::set<std::string> refused_;                     ///< robot names warned about once each
   ros::Subscriber sync_sub_;
   std::map<std::string, Waiter> waiting_;             ///< robot -> its controller's last sync
   std::map<std::string, Received> received_;          ///< robot -> commands received, listeners

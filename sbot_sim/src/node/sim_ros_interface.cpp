@@ -143,7 +143,10 @@ bool SimRosInterface::init() {
   if (params_.lockstep.enabled) {
     std::vector<std::string> names;
     for (const auto& r : robots_) names.push_back(r->name());
-    lockstep_ = std::make_unique<LockstepGate>(nh_, params_.lockstep, names);
+    lockstep_ = std::make_unique<LockstepGate>(nh_, params_.lockstep, names, [this](const std::string& name) {
+      std::string why;
+      return lookupRobot(world_.get(), name, why) ? std::string() : why;
+    });
   }
   bool modules = true;  // ~modules: false = no sensor/actuator modules (benchmarking the bare node)
   pnh_.param("modules", modules, true);
