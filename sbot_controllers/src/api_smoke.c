@@ -1,9 +1,16 @@
 /* Calls every function of the standard s-bot API (sbot.h) once against the simulator and checks the
  * answers are plausible. Used by test/sbot_api_functions.test (test_sbot_api_functions.py); run in the
  * namespace of a Detailed s-bot (every module exists). Prints "FAIL: ..." lines and exits 1 on any
- * failure, "SBOT_API_OK" and 0 otherwise. Wall-clock waits: run the simulator at real time. */
+ * failure, "SBOT_API_OK" and 0 otherwise. Wall-clock waits: run the simulator at real time.
+ *
+ * `sbot_api_smoke missing`, in the namespace of a Simple s-bot (no ground or light sensors, no side
+ * arm): each getter of a missing module reports one error (once, not per call) and returns at once,
+ * as a failed read does (sensor arrays 0, the side arm's outputs untouched); prints
+ * "SBOT_API_MISSING_OK". */
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "sbot.h"
@@ -21,13 +28,43 @@ static void onWarning(const char *text) { ++warnings; fprintf(stderr, "warning: 
     }                                     \
   } while (0)
 
-int main(void) {
+static double wallSeconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+/* Getters of modules a Simple s-bot lacks: one error each, at once, as a failed read. */
+static int missingModules(void) {
+  unsigned ground[4] = {7, 7, 7, 7}, light[8] = {7, 7, 7, 7, 7, 7, 7, 7};
+  int e = 7, ro = 7, d = 7, round;
+  double t0;
+  initSwarmBot(onError, onWarning);
+  CHECK(errors == 0, "initSwarmBot reported errors\n");
+  t0 = wallSeconds();
+  for (round = 0; round < 3; ++round) {
+    getAllGroundSensors(ground);
+    getAllLightSensors(light);
+    getSideArmPos(&e, &ro, &d);
+  }
+  /* Before: each call waited 2 s for a message that never comes (18 s for these 9 calls). */
+  CHECK(wallSeconds() - t0 < 3.0, "9 getters of missing modules took %.1f s\n", wallSeconds() - t0);
+  CHECK(errors == 3, "%d errors for ground, light and side arm (expected one each)\n", errors);
+  CHECK(ground[0] == 0 && light[0] == 0 && e == 7, "ground %u, light %u, side arm elevation %d: expected 0, 0 and "
+        "untouched 7\n", ground[0], light[0], e);
+  shutdownSwarmBot();
+  if (failures == 0) printf("SBOT_API_MISSING_OK\n");
+  return failures == 0 ? 0 : 1;
+}
+
+int main(int argc, char **argv) {
   int l = -999, r = -999, e, ro, d, pitch = 999, roll = 999, w0, i;
   unsigned in = 9999, ex = 9999, co = 9999, prox[15], ground[4], light[8];
   float t = -99, h = -99;
   unsigned rr[8] = {15, 0, 0, 15, 0, 0, 15, 0}, gg[8] = {0}, bb[8] = {0, 15, 0, 0, 15, 0, 0, 15};
   BlinkingRate blink[8] = {0, 1, 2, 3, 4, 5, 6, 7};
 
+  if (argc > 1 && strcmp(argv[1], "missing") == 0) return missingModules();
   initSwarmBot(onError, onWarning);
   CHECK(errors == 0, "initSwarmBot reported errors\n");
 

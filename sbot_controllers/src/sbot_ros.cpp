@@ -7,6 +7,8 @@
 //   spinner thread. It waits (up to 30 s wall) for the robot's services.
 // * Getters return the latest received value. Topics are subscribed on first use (a sensor nobody
 //   reads costs the simulator nothing); the first call waits up to 2 s wall for a first message.
+//   A getter of a module the robot's level lacks (<robot>/sensors_available) returns at once as a
+//   failed read and reports it once.
 // * Sampled sensors (proximity, ground, light, slope) behave like the hardware's sampling: a reading
 //   of one sensor is refreshed once per sampling period. A getter asked again for a sensor whose
 //   current sample it already returned waits (up to 1 s wall) for the next sample. A controller's
@@ -41,6 +43,7 @@
 #include <fstream>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -56,6 +59,7 @@
 #include <sbot_msgs/SetGripper.h>
 #include <sbot_msgs/SetLeds.h>
 #include <sbot_msgs/SetSamplingRate.h>
+#include <sbot_msgs/SensorsAvailable.h>
 #include <sbot_msgs/SetSideArm.h>
 #include <sbot_msgs/SetTurret.h>
 #include <sbot_msgs/SideArmState.h>
@@ -132,6 +136,45 @@ struct HoldState {
 };
 HoldState g_hold;
 
+/// What the robot's model level offers (<robot>/sensors_available, latched; republished when the
+/// level changes). A getter of a topic the level does not publish returns at once, reporting it
+/// once, instead of waiting for a message that never comes.
+struct Availability {
+  std::mutex m;
+  std::atomic<bool> known{false};
+  std::string robot, level;
+  std::set<std::string> channels;
+  std::set<std::string> reported;  ///< "level/topic" already reported
+  ros::Subscriber sub;
+
+  void update(const sbot_msgs::SensorsAvailable& msg) {
+    std::lock_guard<std::mutex> l(m);
+    known = true;
+    robot = msg.robot;
+    level = msg.level;
+    channels = std::set<std::string>(msg.channels.begin(), msg.channels.end());
+  }
+  /// False (after reporting once through the error handler) if `topic` is one the level may lack
+  /// and does not publish.
+  bool offers(const std::string& topic) {
+    static const std::set<std::string> optional = {"proximity", "ground", "light", "slope", "battery",
+                                                   "climate", "gripper/state", "side_arm/state"};
+    std::string message;
+    {
+      std::lock_guard<std::mutex> l(m);
+      if (!known || !optional.count(topic) || channels.count(topic)) return true;
+      if (!reported.insert(level + "/" + topic).second) return false;
+      std::string list;
+      for (const auto& c : channels) list += (list.empty() ? "" : " ") + c;
+      message = robot + " is a " + level + " s-bot, which has no " + topic + " (it offers: " + list +
+                "); the getter returns without a value";
+    }
+    report(true, "%s", message.c_str());
+    return false;
+  }
+};
+Availability g_available;
+
 /// Latest message of one topic, subscribed on first use, with per-index "already returned" stamps.
 template <class Msg>
 class Latest {
@@ -141,6 +184,7 @@ class Latest {
   /// Copy of the latest message; waits for a first one, and (with `fresh`) for one newer than the
   /// sample index `index` last returned (index = npos: all indices).
   bool get(ros::NodeHandle& nh, Msg* out, bool fresh = false, std::size_t index = npos) {
+    if (!g_available.offers(topic_)) return false;
     std::unique_lock<std::mutex> lock(m_);
     if (!sub_) {
       sub_ = nh.subscribe<Msg>(topic_, 5, [this](const typename Msg::ConstPtr& msg) {
@@ -399,6 +443,10 @@ void initSwarmBot(void (*errorHandler)(const char*), void (*warningHandler)(cons
   }
   const auto until = Clock::now() + std::chrono::seconds(5);
   while (g->speed_pub.getNumSubscribers() == 0 && Clock::now() < until) usleep(10000);
+  g_available.sub = g->nh->subscribe<sbot_msgs::SensorsAvailable>(
+      "sensors_available", 1, [](const sbot_msgs::SensorsAvailable::ConstPtr& m) { g_available.update(*m); },
+      ros::VoidConstPtr(), ros::TransportHints());
+  while (!g_available.known && Clock::now() < until + std::chrono::seconds(2)) usleep(10000);
   g->lockstep = std::make_unique<sbot_controllers::LockstepClient>(*g->nh);
   if (g->lockstep->enabled()) {
     g_hold.sub = g->nh->subscribe<sbot_msgs::LockstepHold>("lockstep_hold", 10, [](const sbot_msgs::LockstepHold::ConstPtr& h) {
@@ -425,6 +473,7 @@ void shutdownSwarmBot(void) {
   }
   g_lockstep = false;
   g_hold.sub.shutdown();
+  g_available.sub.shutdown();
   g->spinner->stop();
   g.reset();
   ros::shutdown();
