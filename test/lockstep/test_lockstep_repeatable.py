@@ -19,6 +19,7 @@ import time
 import unittest
 
 import rosbag
+import rosgraph
 
 SIM_SECONDS = 20.0
 
@@ -55,27 +56,50 @@ def run_once(workdir, tag, lockstep=True):
     port = free_port()
     env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % port)
     bag = os.path.join(workdir, tag + ".bag")
-    launch = launch_phototaxis(env, "lockstep:=%s" % ("true" if lockstep else "false"),
-                               "duration:=%g" % SIM_SECONDS, "real_time_factor:=0")
-    recorder = None
+    # Our own master, and the recorder subscribed before the launch starts (roslaunch -p uses the
+    # running master): a recorder started beside the launch could miss a short run altogether.
+    master = subprocess.Popen(["rosmaster", "--core", "-p", str(port)], env=env,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    recorder = launch = None
     try:
-        # The simulator waits for its three controllers before the first step; the recorder is
-        # usually subscribed by then, and only stamps present in both runs are compared anyway.
+        graph = rosgraph.Master("/lockstep_test", master_uri=env["ROS_MASTER_URI"])
+        wait_until(lambda: graph.is_online(), 20, "the ROS master on port %d" % port)
+        # Its own process group: `rosbag record` runs the recorder as a child process, and only a
+        # SIGINT to both closes the bag (otherwise it can stay behind as <bag>.active).
         recorder = subprocess.Popen(["rosbag", "record", "-q", "-O", bag, "/swarm/graph"], env=env,
-                                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+        wait_until(lambda: any(t == "/swarm/graph" for t, _ in graph.getSystemState()[1]), 20,
+                   "rosbag record subscribing to /swarm/graph")
+        launch = launch_phototaxis(env, "lockstep:=%s" % ("true" if lockstep else "false"),
+                                   "duration:=%g" % SIM_SECONDS, "real_time_factor:=0")
         out, _ = launch.communicate(timeout=180)
     finally:
-        if launch.poll() is None:
+        if launch is not None and launch.poll() is None:
             launch.kill()
         if recorder is not None:
-            recorder.send_signal(subprocess.signal.SIGINT)
+            os.killpg(recorder.pid, signal.SIGINT)
             recorder.wait(timeout=30)
+            wait_until(lambda: os.path.exists(bag), 20, "rosbag record closing " + bag)
+        master.terminate()
+        master.wait(timeout=30)
     summary = [l for l in out.splitlines() if "duration reached" in l]
     positions = {}
     with rosbag.Bag(bag) as b:
         for _, m, _ in b.read_messages(topics=["/swarm/graph"]):
             positions[round(m.header.stamp.to_sec(), 3)] = [(p.x, p.y) for p in m.positions]
     return positions, (summary[0] if summary else out[-3000:])
+
+
+def wait_until(condition, timeout, what):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        try:
+            if condition():
+                return
+        except OSError:  # the master is not up yet
+            pass
+        time.sleep(0.1)
+    raise AssertionError("timed out after %d s waiting for %s" % (timeout, what))
 
 
 class LockstepRepeatable(unittest.TestCase):

@@ -222,7 +222,7 @@ void RobotModulesRos::update(double dt, double sim_time) {
       sbot_msgs::ProximityArray m;
       m.header = header(turret);
       for (int k = 0; k < sn::kProximitySensors; ++k) m.readings[k] = static_cast<uint16_t>(all[k]);
-      pubs_["proximity"].publish(m); publicationStamps().note(name_, "proximity", m.header.stamp);
+      publishNoted(pubs_["proximity"], name_, "proximity", m);
       if (any_ir && suite_->proximity()) {
         const auto& resp = suite_->proximity()->response();
         for (int k = 0; k < sn::kProximitySensors; ++k) {
@@ -245,7 +245,7 @@ void RobotModulesRos::update(double dt, double sim_time) {
     m.header = header(base);
     const auto all = suite_->getAllGroundSensors();
     for (int k = 0; k < sn::kGroundSensors; ++k) m.readings[k] = static_cast<uint16_t>(all[k]);
-    pubs_["ground"].publish(m); publicationStamps().note(name_, "ground", m.header.stamp);
+    publishNoted(pubs_["ground"], name_, "ground", m);
   }
   {
     // The compact array and, for whoever subscribes, one sensor_msgs/Illuminance per sensor (the
@@ -257,7 +257,7 @@ void RobotModulesRos::update(double dt, double sim_time) {
       m.header = header(turret);
       const auto all = suite_->getAllLightSensors();
       for (int k = 0; k < sn::kLightSensors; ++k) m.readings[k] = static_cast<uint16_t>(all[k]);
-      pubs_["light"].publish(m); publicationStamps().note(name_, "light", m.header.stamp);
+      publishNoted(pubs_["light"], name_, "light", m);
       if (any_single && suite_->light()) {
         const sn::LightSensorParams& lp = suite_->light()->params();
         constexpr double kLuxPerMcdPerCm2 = 10.0;  // 1e-3 cd / 1e-4 m^2
@@ -281,7 +281,7 @@ void RobotModulesRos::update(double dt, double sim_time) {
     suite_->getSlope(&pitch, &roll);
     m.pitch = static_cast<int16_t>(pitch);
     m.roll = static_cast<int16_t>(roll);
-    pubs_["slope"].publish(m); publicationStamps().note(name_, "slope", m.header.stamp);
+    publishNoted(pubs_["slope"], name_, "slope", m);
   }
   if (due("imu", sim_time)) {
     sensor_msgs::Imu m;
@@ -336,7 +336,7 @@ void RobotModulesRos::update(double dt, double sim_time) {
     m.barrier_combined = static_cast<uint16_t>(b.combined);
     m.gripping = gripper_->gripping();
     m.gripped = gripper_->gripped();
-    pubs_["gripper"].publish(m); publicationStamps().note(name_, "gripper/state", m.header.stamp);
+    publishNoted(pubs_["gripper"], name_, "gripper/state", m);
   }
   if (due("side_arm", sim_time) && side_arm_->available()) {
     sbot_msgs::SideArmState m;
@@ -357,7 +357,7 @@ void RobotModulesRos::update(double dt, double sim_time) {
     m.barrier_combined = static_cast<uint16_t>(b.combined);
     m.gripping = side_arm_->gripping();
     m.gripped = side_arm_->gripped();
-    pubs_["side_arm"].publish(m); publicationStamps().note(name_, "side_arm/state", m.header.stamp);
+    publishNoted(pubs_["side_arm"], name_, "side_arm/state", m);
   }
   if (due("battery", sim_time)) {
     sbot_msgs::Battery m;
@@ -365,14 +365,14 @@ void RobotModulesRos::update(double dt, double sim_time) {
     m.voltage_units = static_cast<uint8_t>(suite_->getBatteryVoltage());
     m.voltage = suite_->battery().voltage();
     m.charge_mAh = suite_->battery().stateOfCharge() * 1400.0;
-    pubs_["battery"].publish(m); publicationStamps().note(name_, "battery", m.header.stamp);
+    publishNoted(pubs_["battery"], name_, "battery", m);
   }
   if (due("climate", sim_time)) {
     sbot_msgs::Climate m;
     m.header = header(turret);
     suite_->getTemperatureAndHumidityLeft(&m.temperature_left, &m.humidity_left);
     suite_->getTemperatureAndHumidityRight(&m.temperature_right, &m.humidity_right);
-    pubs_["climate"].publish(m); publicationStamps().note(name_, "climate", m.header.stamp);
+    publishNoted(pubs_["climate"], name_, "climate", m);
   }
   if (due("leds", sim_time)) {
     sbot_msgs::LedState m;

@@ -8,6 +8,7 @@
 #include <map>
 #include <string>
 
+#include <ros/publisher.h>
 #include <ros/time.h>
 
 namespace sbot_node {
@@ -31,6 +32,13 @@ class PublicationStamps {
 inline PublicationStamps& publicationStamps() {
   static PublicationStamps stamps;
   return stamps;
+}
+
+/// Publish `msg` (a message with a header) on robot/topic and note its stamp.
+template <class M>
+void publishNoted(const ros::Publisher& pub, const std::string& robot, const std::string& topic, const M& msg) {
+  pub.publish(msg);
+  publicationStamps().note(robot, topic, msg.header.stamp);
 }
 
 }  // namespace sbot_node

@@ -166,8 +166,7 @@ void RobotRosInterface::publishState(const ros::Time& stamp,
     const sbot::Quat q_inv = base.orientation.conjugate();
     odom.twist.twist.linear = toVector3(q_inv * v_world);
     odom.twist.twist.angular = toVector3(q_inv * r.angularVelocity());
-    ground_truth_pub_.publish(odom);
-    publicationStamps().note(name_, "ground_truth", odom.header.stamp);
+    publishNoted(ground_truth_pub_, name_, "ground_truth", odom);
   }
 
   if (joint_states_pub_.getNumSubscribers() > 0) {
@@ -196,8 +195,7 @@ void RobotRosInterface::publishState(const ros::Time& stamp,
     ts.measured_right = static_cast<int16_t>(mr);
     ts.torque_left = static_cast<int16_t>(tl);
     ts.torque_right = static_cast<int16_t>(tr);
-    track_state_pub_.publish(ts);
-    publicationStamps().note(name_, "track_state", ts.header.stamp);
+    publishNoted(track_state_pub_, name_, "track_state", ts);
   }
 
   if (turret_state_pub_.getNumSubscribers() > 0 && !r.description().turret.joint.empty()) {
@@ -207,8 +205,7 @@ void RobotRosInterface::publishState(const ros::Time& stamp,
     tu.rotation = static_cast<int16_t>(r.getTurretRotation());
     tu.torque = static_cast<int16_t>(r.getTurretRotationTorque());
     tu.angle = r.turretAngle();
-    turret_state_pub_.publish(tu);
-    publicationStamps().note(name_, "turret/state", tu.header.stamp);
+    publishNoted(turret_state_pub_, name_, "turret/state", tu);
   }
 
   geometry_msgs::TransformStamped tf;
