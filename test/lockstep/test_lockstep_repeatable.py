@@ -57,15 +57,16 @@ def run_once(workdir, tag, lockstep=True):
     env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % port)
     bag = os.path.join(workdir, tag + ".bag")
     # Our own master, and the recorder subscribed before the launch starts (roslaunch -p uses the
-    # running master): a recorder started beside the launch could miss a short run altogether.
+    # running master). A recorder started beside the launch, before roslaunch had brought its master
+    # up, missed the whole (2 s wall) run once on a loaded machine and wrote no bag.
     master = subprocess.Popen(["rosmaster", "--core", "-p", str(port)], env=env,
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     recorder = launch = None
     try:
         graph = rosgraph.Master("/lockstep_test", master_uri=env["ROS_MASTER_URI"])
         wait_until(lambda: graph.is_online(), 20, "the ROS master on port %d" % port)
-        # Its own process group: `rosbag record` runs the recorder as a child process, and only a
-        # SIGINT to both closes the bag (otherwise it can stay behind as <bag>.active).
+        # Its own process group, stopped as a whole: `rosbag record` runs the recorder as a child
+        # process, and the SIGINT should reach it too, as a Ctrl-C in a terminal would.
         recorder = subprocess.Popen(["rosbag", "record", "-q", "-O", bag, "/swarm/graph"], env=env,
                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
         wait_until(lambda: any(t == "/swarm/graph" for t, _ in graph.getSystemState()[1]), 20,
