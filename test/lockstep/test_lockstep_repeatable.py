@@ -57,8 +57,8 @@ def run_once(workdir, tag, lockstep=True):
     env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % port)
     bag = os.path.join(workdir, tag + ".bag")
     # Our own master, and the recorder subscribed before the launch starts (roslaunch -p uses the
-    # running master). A recorder started beside the launch, before roslaunch had brought its master
-    # up, missed the whole (2 s wall) run once on a loaded machine and wrote no bag.
+    # running master). With the recorder started beside the launch, one fresh-clone run found no bag
+    # at all; most likely the recorder was still waiting for roslaunch's master when the 2 s run ended.
     master = subprocess.Popen(["rosmaster", "--core", "-p", str(port)], env=env,
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     recorder = launch = None
