@@ -5,7 +5,7 @@ Runs launch/sbot_api_phototaxis.launch (3 Medium s-bots, one phototaxis controll
 twice with lockstep:=true, as fast as possible, each with its own ROS master on a free port, records
 /swarm/graph, and checks that the robots' positions agree at every common stamp (to 1e-9 m) and that
 the robots moved. The same for swarm.launch (5 Simple s-bots, one random_walk node each, recorded
-by the launch's own rosbag). Without lock-step the controllers answer a varying number of steps late and the
+by the launch's own rosbag at 10 Hz). Without lock-step the controllers answer a varying number of steps late and the
 two runs differ (see the README, "Lock-step"). A third run freezes one controller (SIGSTOP, as a
 hung controller or a debugger would) in the middle: the simulator drops it after ~lockstep_timeout
 and finishes the run. (A controller that dies outright unsubscribes, so nothing is held for it.)
@@ -153,7 +153,7 @@ class LockstepRepeatable(unittest.TestCase):
             bag = os.path.join(workdir, tag + ".bag")
             p = subprocess.run(["roslaunch", "-p", env["ROS_MASTER_URI"].rsplit(":", 1)[1], "swarmbot3d", "swarm.launch",
                                 "robots:=5", "lockstep:=true", "record:=true", "bag:=" + bag, "duration:=20",
-                                "publish_rate:=20"],
+                                "publish_rate:=10"],
                                env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=180)
             summary = [l for l in p.stdout.splitlines() if "duration reached" in l]
             self.assertEqual(len(summary), 1, p.stdout[-3000:])
@@ -167,8 +167,10 @@ class LockstepRepeatable(unittest.TestCase):
         with tempfile.TemporaryDirectory() as d:
             a, b = run(d, "a"), run(d, "b")
         common = set(a) & set(b)
-        # rosbag may drop some of the 5 x 20 Hz x 20 s ground-truth messages; most are in both runs.
-        self.assertGreater(len(common), 0.5 * 5 * 20 * 20, "too few common ground-truth samples: %d" % len(common))
+        # rosbag drops some of the 5 x 10 Hz x 20 s ground-truth messages, differently in each run (a
+        # fresh-clone run at 20 Hz kept 920 of 2000 in both): compare those both runs have, over the run.
+        self.assertGreater(len(common), 0.3 * 5 * 10 * 20, "too few common ground-truth samples: %d" % len(common))
+        self.assertGreaterEqual(max(t for _, t in common), 15.0, "no common sample late in the run")
         worst = max(abs(a[k][i] - b[k][i]) for k in common for i in (0, 1))
         ends = {}
         for (topic, t), p in sorted(a.items(), key=lambda kv: kv[0][1]):
