@@ -58,9 +58,8 @@ class RandomWalk {
     if (lockstep_->enabled()) {
       // Every message in order (ground truth is published at ~publish_rate, faster than the ticks).
       sub_ = nh.subscribe("ground_truth", 100, &RandomWalk::onPose, this, ros::TransportHints().tcpNoDelay());
-      const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-      while (sub_.getNumPublishers() == 0 && std::chrono::steady_clock::now() < until && ros::ok()) usleep(10000);
-      while (pub_.getNumSubscribers() == 0 && std::chrono::steady_clock::now() < until && ros::ok()) usleep(10000);
+      sbot_controllers::pollUntil([this] { return sub_.getNumPublishers() > 0 && pub_.getNumSubscribers() > 0; },
+                                  std::chrono::steady_clock::now() + std::chrono::seconds(10));
       next_tick_ = ros::Time(0) + period_;
       announceNextTick();
       ROS_INFO("random_walk %s: in lock-step with the simulator", nh.getNamespace().c_str());

@@ -100,6 +100,18 @@ std::chrono::seconds waitLimit(int normal) { return std::chrono::seconds(g_locks
 /// `first`: the controller has just subscribed; the connection is awaited first (up to 5 s).
 void announceWait(const std::string& channel, const ros::Time& after, const ros::Subscriber& sub, bool first);
 
+/// Wait on `cv` (its `lock` held) in 100 ms slices until `ready`, `deadline`, ROS shuts down, or, if
+/// `sim` is given, that subscription has lost its publisher: the simulator is gone, and a controller
+/// stopped with it must not stay blocked.
+template <class Ready>
+void waitSliced(std::unique_lock<std::mutex>& lock, std::condition_variable& cv, Clock::time_point deadline,
+                const ros::Subscriber* sim, Ready ready) {
+  while (!ready() && ros::ok() && Clock::now() < deadline) {
+    cv.wait_for(lock, std::chrono::milliseconds(100), ready);
+    if (sim && *sim && sim->getNumPublishers() == 0) break;
+  }
+}
+
 /// Lock-step: where the simulator holds for this controller. A controller runs only while the
 /// simulator holds its clock at `now` for it (it woke on a message stamped `now`); the simulator
 /// then sends a LockstepHold listing what it has published on each topic up to `now`, and every
@@ -124,11 +136,7 @@ struct HoldState {
   /// The latest stamp published on `topic` up to `now` (waits for the hold of `now`; 0 = unknown).
   ros::Time latestOf(const std::string& topic) {
     std::unique_lock<std::mutex> l(m);
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-    while (held < now && ros::ok() && std::chrono::steady_clock::now() < deadline) {
-      cv.wait_for(l, std::chrono::milliseconds(100));
-      if (sub && sub.getNumPublishers() == 0) break;  // the simulator is gone
-    }
+    waitSliced(l, cv, Clock::now() + std::chrono::seconds(30), &sub, [this] { return held >= now; });
     if (held < now) return ros::Time(0);
     const auto it = latest.find(topic);
     return it == latest.end() ? ros::Time(0) : it->second;
@@ -264,11 +272,7 @@ class Latest {
   /// simulator is not left blocked for the full 30 s).
   template <class Pred>
   void waitUntil(std::unique_lock<std::mutex>& lock, int normal, Pred ready) {
-    const auto deadline = Clock::now() + waitLimit(normal);
-    while (!ready() && ros::ok() && Clock::now() < deadline) {
-      cv_.wait_for(lock, std::chrono::milliseconds(100), ready);
-      if (g_lockstep && sub_.getNumPublishers() == 0) break;
-    }
+    waitSliced(lock, cv_, Clock::now() + waitLimit(normal), g_lockstep ? &sub_ : nullptr, ready);
   }
   static bool sampleWait() {
     static const bool wait = !(std::getenv("SBOT_NO_SAMPLE_WAIT") && std::string(std::getenv("SBOT_NO_SAMPLE_WAIT")) == "1");
@@ -314,8 +318,7 @@ std::unique_ptr<Api> g;
 void announceWait(const std::string& channel, const ros::Time& after, const ros::Subscriber& sub, bool first) {
   if (!g_lockstep || !g) return;
   // The simulator can only hold for a message it can deliver: wait for the connection first.
-  const auto until = Clock::now() + std::chrono::seconds(5);
-  while (first && sub.getNumPublishers() == 0 && Clock::now() < until && ros::ok()) usleep(1000);
+  if (first) sbot_controllers::pollUntil([&sub] { return sub.getNumPublishers() > 0; }, Clock::now() + std::chrono::seconds(5));
   if (channel.empty())
     g->lockstep->leaving();
   else
@@ -442,11 +445,11 @@ void initSwarmBot(void (*errorHandler)(const char*), void (*warningHandler)(cons
     return;
   }
   const auto until = Clock::now() + std::chrono::seconds(5);
-  while (g->speed_pub.getNumSubscribers() == 0 && Clock::now() < until) usleep(10000);
+  sbot_controllers::pollUntil([] { return g->speed_pub.getNumSubscribers() > 0; }, until);
   g_available.sub = g->nh->subscribe<sbot_msgs::SensorsAvailable>(
       "sensors_available", 1, [](const sbot_msgs::SensorsAvailable::ConstPtr& m) { g_available.update(*m); },
       ros::VoidConstPtr(), ros::TransportHints());
-  while (!g_available.known && Clock::now() < until + std::chrono::seconds(2)) usleep(10000);
+  sbot_controllers::pollUntil([] { return g_available.known.load(); }, until + std::chrono::seconds(2));
   g->lockstep = std::make_unique<sbot_controllers::LockstepClient>(*g->nh);
   if (g->lockstep->enabled()) {
     g_hold.sub = g->nh->subscribe<sbot_msgs::LockstepHold>("lockstep_hold", 10, [](const sbot_msgs::LockstepHold::ConstPtr& h) {
@@ -456,7 +459,7 @@ void initSwarmBot(void (*errorHandler)(const char*), void (*warningHandler)(cons
       for (std::size_t k = 0; k < h->topics.size() && k < h->latest.size(); ++k) g_hold.latest[h->topics[k]] = h->latest[k];
       g_hold.cv.notify_all();
     }, ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
-    while (g_hold.sub.getNumPublishers() == 0 && Clock::now() < until + std::chrono::seconds(5)) usleep(10000);
+    sbot_controllers::pollUntil([] { return g_hold.sub.getNumPublishers() > 0; }, until + std::chrono::seconds(5));
     if (!g->lockstep->connected() || g_hold.sub.getNumPublishers() == 0)
       report(false, "initSwarmBot: the simulator runs in lock-step but is not connected on /sim/controller_sync "
                     "and %s", g_hold.sub.getTopic().c_str());

@@ -19,6 +19,14 @@
 
 namespace sbot_controllers {
 
+/// Poll `done` every 5 ms until it holds, `deadline` passes or ROS shuts down; returns done().
+/// (Connections and latched messages arrive on roscpp's own threads.)
+template <class Done>
+bool pollUntil(Done done, std::chrono::steady_clock::time_point deadline) {
+  while (!done() && std::chrono::steady_clock::now() < deadline && ros::ok()) usleep(5000);
+  return done();
+}
+
 class LockstepClient {
  public:
   /// `nh`: a node handle in the robot's namespace. Reads /sim/lockstep (set by the simulator, which
@@ -30,8 +38,8 @@ class LockstepClient {
     robot_ = nh.getNamespace();
     while (!robot_.empty() && robot_.front() == '/') robot_.erase(0, 1);
     pub_ = nh.advertise<sbot_msgs::ControllerSync>("/sim/controller_sync", 100);
-    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    while (pub_.getNumSubscribers() == 0 && std::chrono::steady_clock::now() < until && ros::ok()) usleep(10000);
+    pollUntil([this] { return pub_.getNumSubscribers() > 0; },
+              std::chrono::steady_clock::now() + std::chrono::seconds(10));
   }
 
   bool enabled() const { return enabled_; }

@@ -1,5 +1,6 @@
 #include "lockstep_gate.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <utility>
 
@@ -53,11 +54,11 @@ void LockstepGate::onSync(const sbot_msgs::ControllerSync::ConstPtr& msg) {
     return;
   }
   if (announced_.insert(robot).second) {
-    if (!received_.count(robot)) {
+    if (!robots_.count(robot)) {
       // A robot spawned after the start: what its controller sent before now is taken as arrived.
       attachRobot(robot);
-      received_[robot].speed = msg->speed_commands;
-      received_[robot].speaker = msg->speaker_commands;
+      robots_[robot].speed = msg->speed_commands;
+      robots_[robot].speaker = msg->speaker_commands;
     }
     ROS_INFO("simulator: lockstep: the controller of %s joined (%zu of %d awaited)", robot.c_str(),
              announced_.size(), params_.controllers);
@@ -67,18 +68,19 @@ void LockstepGate::onSync(const sbot_msgs::ControllerSync::ConstPtr& msg) {
 }
 
 void LockstepGate::attachRobot(const std::string& robot) {
-  Received& r = received_[robot];
+  RobotState& r = robots_[robot];
   r.hold_pub = nh_.advertise<sbot_msgs::LockstepHold>("/" + robot + "/lockstep_hold", 10, /*latch=*/true);
   const std::string ns = "/" + robot + "/";
   // Counted beside the robot interface's own subscriptions: one connection delivers to both.
   r.subs.push_back(nh_.subscribe<sbot_msgs::TrackSpeed>(ns + "cmd_speed", 100,
-      [this, robot](const sbot_msgs::TrackSpeed::ConstPtr&) { ++received_[robot].speed; }));
+      [this, robot](const sbot_msgs::TrackSpeed::ConstPtr&) { ++robots_[robot].speed; }));
   r.subs.push_back(nh_.subscribe<std_msgs::Float64>(ns + "speaker", 100,
-      [this, robot](const std_msgs::Float64::ConstPtr&) { ++received_[robot].speaker; }));
+      [this, robot](const std_msgs::Float64::ConstPtr&) { ++robots_[robot].speaker; }));
 }
 
 void LockstepGate::watch(const std::string& robot, const std::string& channel) {
-  if (!watched_.insert(robot + "/" + channel).second) return;
+  std::vector<std::string>& channels = robots_[robot].channels;
+  if (std::find(channels.begin(), channels.end(), channel) != channels.end()) return;
   if (!trackedChannels().count(channel)) {
     if (unknown_channels_.insert(channel).second) {
       std::string known;
@@ -88,11 +90,11 @@ void LockstepGate::watch(const std::string& robot, const std::string& channel) {
     }
     return;
   }
-  received_[robot].channels.push_back(channel);
+  channels.push_back(channel);
 }
 
 void LockstepGate::publishHold(const std::string& robot, const ros::Time& stamp) {
-  Received& r = received_[robot];
+  RobotState& r = robots_[robot];
   if (r.hold_sent >= stamp) return;
   r.hold_sent = stamp;
   sbot_msgs::LockstepHold h;
@@ -104,25 +106,28 @@ void LockstepGate::publishHold(const std::string& robot, const ros::Time& stamp)
   r.hold_pub.publish(h);
 }
 
-std::string LockstepGate::holdReason(const Waiter& w) const {
+LockstepGate::Hold LockstepGate::holdFor(const Waiter& w, ros::Time* published) const {
   const sbot_msgs::ControllerSync& s = w.sync;
-  const auto r = received_.find(s.robot);
-  const std::uint64_t speed = r == received_.end() ? 0 : r->second.speed;
-  const std::uint64_t speaker = r == received_.end() ? 0 : r->second.speaker;
-  char why[256];
-  if (speed < s.speed_commands || speaker < s.speaker_commands) {
-    std::snprintf(why, sizeof(why), "commands in flight (cmd_speed %llu of %llu, speaker %llu of %llu received)",
-                  static_cast<unsigned long long>(speed), static_cast<unsigned long long>(s.speed_commands),
-                  static_cast<unsigned long long>(speaker), static_cast<unsigned long long>(s.speaker_commands));
-    return why;
-  }
-  const ros::Time published = publicationStamps().latest(s.robot, s.channel);
-  if (published > s.after) {
-    std::snprintf(why, sizeof(why), "has %s stamped %.3f s to read (it last read %.3f s)", s.channel.c_str(),
+  *published = publicationStamps().latest(s.robot, s.channel);
+  const auto r = robots_.find(s.robot);
+  if (r != robots_.end() && (r->second.speed < s.speed_commands || r->second.speaker < s.speaker_commands))
+    return Hold::Commands;
+  return *published > s.after ? Hold::Message : Hold::None;
+}
+
+std::string LockstepGate::describe(const Waiter& w, Hold why, const ros::Time& published) const {
+  const sbot_msgs::ControllerSync& s = w.sync;
+  char text[256];
+  if (why == Hold::Commands) {
+    const RobotState& r = robots_.at(s.robot);
+    std::snprintf(text, sizeof(text), "commands in flight (cmd_speed %llu of %llu, speaker %llu of %llu received)",
+                  static_cast<unsigned long long>(r.speed), static_cast<unsigned long long>(s.speed_commands),
+                  static_cast<unsigned long long>(r.speaker), static_cast<unsigned long long>(s.speaker_commands));
+  } else {
+    std::snprintf(text, sizeof(text), "has %s stamped %.3f s to read (it last read %.3f s)", s.channel.c_str(),
                   published.toSec(), s.after.toSec());
-    return why;
   }
-  return "";
+  return text;
 }
 
 bool LockstepGate::mayStep() {
@@ -136,22 +141,22 @@ bool LockstepGate::mayStep() {
              "%zu so far (%s)", params_.controllers, announced_.size(), joined.empty() ? "none" : joined.c_str());
   }
   for (auto it = waiting_.begin(); it != waiting_.end();) {
-    const std::string why = holdReason(it->second);
-    if (why.empty()) {
+    ros::Time published;
+    const Hold why = holdFor(it->second, &published);
+    if (why == Hold::None) {
       ++it;
       continue;
     }
     if (secondsBetween(it->second.since, now) > params_.timeout) {
       ROS_WARN("simulator: lockstep: dropping the controller of %s: no sync for %.1f s wall while it %s; "
                "the simulation no longer waits for it (~lockstep_timeout %.1f s)", it->first.c_str(),
-               secondsBetween(it->second.since, now), why.c_str(), params_.timeout);
+               secondsBetween(it->second.since, now), describe(it->second, why, published).c_str(), params_.timeout);
       ++dropped_;
       it = waiting_.erase(it);
       continue;
     }
     hold = true;
     // Holding for a new message: the controller wakes at its stamp and acts there.
-    const ros::Time published = publicationStamps().latest(it->first, it->second.sync.channel);
     if (published > it->second.sync.after) publishHold(it->first, published);
     ++it;
   }

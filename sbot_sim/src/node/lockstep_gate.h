@@ -63,13 +63,14 @@ class LockstepGate {
     sbot_msgs::ControllerSync sync;
     std::chrono::steady_clock::time_point since;  ///< when this sync arrived
   };
-  struct Received {
-    std::uint64_t speed = 0, speaker = 0;
-    std::vector<ros::Subscriber> subs;
-    std::vector<std::string> channels;  ///< watched topics under the robot
-    ros::Publisher hold_pub;            ///< <robot>/lockstep_hold (latched)
-    ros::Time hold_sent;                ///< stamp of the last hold told
+  struct RobotState {
+    std::uint64_t speed = 0, speaker = 0;  ///< cmd_speed / speaker messages received
+    std::vector<ros::Subscriber> subs;     ///< their counters
+    std::vector<std::string> channels;     ///< topics under the robot its controller reads
+    ros::Publisher hold_pub;               ///< <robot>/lockstep_hold (latched)
+    ros::Time hold_sent;                   ///< stamp of the last hold told
   };
+  enum class Hold { None, Commands, Message };
 
   void onSync(const sbot_msgs::ControllerSync::ConstPtr& msg);
   /// Count the cmd_speed and speaker messages that reach `robot` and advertise its lockstep_hold
@@ -79,8 +80,11 @@ class LockstepGate {
   void publishHold(const std::string& robot, const ros::Time& stamp);
   /// Include robot/channel in the robot's holds (once); warn about a topic the node does not track.
   void watch(const std::string& robot, const std::string& channel);
-  /// Why the controller of `w` holds the clock ("" = it does not).
-  std::string holdReason(const Waiter& w) const;
+  /// Whether the controller of `w` holds the clock, and why; `published` gets the stamp of the
+  /// latest message on the topic it waits for.
+  Hold holdFor(const Waiter& w, ros::Time* published) const;
+  /// `why` in words, for the warning when the controller of `w` is dropped.
+  std::string describe(const Waiter& w, Hold why, const ros::Time& published) const;
 
   ros::NodeHandle nh_;
   LockstepParams params_;
@@ -88,8 +92,7 @@ class LockstepGate {
   std::set<std::string> refused_;                     ///< robot names warned about once each
   ros::Subscriber sync_sub_;
   std::map<std::string, Waiter> waiting_;             ///< robot -> its controller's last sync
-  std::map<std::string, Received> received_;          ///< robot -> commands received, listeners
-  std::set<std::string> watched_;                     ///< "robot/channel" listened to
+  std::map<std::string, RobotState> robots_;          ///< robot -> commands received, topics read
   std::set<std::string> announced_;                   ///< robots whose controller ever synced
   std::set<std::string> unknown_channels_;            ///< warned once each
   bool was_holding_ = false;

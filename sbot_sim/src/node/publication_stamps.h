@@ -2,7 +2,8 @@
 // getters read (proximity, turret/state, ...), noted by the publishers themselves. The lock-step
 // gate (lockstep_gate.h) reads it: a subscription of the node to its own topics would connect
 // asynchronously and miss the first messages after it is made. The node is single-threaded
-// (sim_ros_interface.h), so there is no locking.
+// (sim_ros_interface.h), so there is no locking. Nothing is recorded until enable() (lock-step
+// only): the publishers' hot path stays as it was otherwise.
 #pragma once
 
 #include <map>
@@ -15,8 +16,9 @@ namespace sbot_node {
 
 class PublicationStamps {
  public:
+  void enable() { enabled_ = true; }
   void note(const std::string& robot, const std::string& topic, const ros::Time& stamp) {
-    latest_[robot + "/" + topic] = stamp;
+    if (enabled_) latest_[robot + "/" + topic] = stamp;
   }
   /// 0 when nothing was published on robot/topic.
   ros::Time latest(const std::string& robot, const std::string& topic) const {
@@ -25,6 +27,7 @@ class PublicationStamps {
   }
 
  private:
+  bool enabled_ = false;
   std::map<std::string, ros::Time> latest_;
 };
 

@@ -1,5 +1,6 @@
 #include "sim_ros_interface.h"
 
+#include "publication_stamps.h"
 #include "robot_lookup.h"
 
 #include "sbot_sim/core/effects/effects_file.h"
@@ -143,6 +144,7 @@ bool SimRosInterface::init() {
   if (params_.lockstep.enabled) {
     std::vector<std::string> names;
     for (const auto& r : robots_) names.push_back(r->name());
+    publicationStamps().enable();
     lockstep_ = std::make_unique<LockstepGate>(nh_, params_.lockstep, names, [this](const std::string& name) {
       std::string why;
       return lookupRobot(world_.get(), name, why) ? std::string() : why;
