@@ -156,7 +156,9 @@ TEST(Generator, WallApproachesRevealTheSurfaceReflectance) {
   for (std::size_t k = 0; k < r.final_fit.free.size(); ++k)
     if (r.final_fit.free[k].name == "black_card") {
       found = true;
-      EXPECT_NEAR(r.final_fit.value[k], 0.3, 0.03) << r.verdict;
+      // 0.27 +- 0.01 when the replays read the IR from the measured (noisy) start pose instead of
+      // the aligned one: readings are convex in the distance, so the pose noise biased them up.
+      EXPECT_NEAR(r.final_fit.value[k], 0.3, 0.015) << r.verdict;
     }
   EXPECT_TRUE(found) << "black_card fitted: " << r.verdict;
 }
