@@ -430,6 +430,7 @@ def build(level, p):
         "rotor_inertia": tr["rotor_inertia_kgm2"],
         "backdrive_force": tr["friction_force_N"],
         "torque_window": tr["torque_window_s"],
+        "creep_stiffness": tr.get("creep_stiffness", 0.0),
         "drive": tr.get("drive", "wheels"),
     }
     sc["turret"] = {"joint": "turret_joint", "speed": api["speed_rads"], "unit": api["unit_rad"],

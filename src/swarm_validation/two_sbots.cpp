@@ -11,7 +11,8 @@
 //   two_sbots [--level detailed] [--trials 3] [--angles 10,20,...] [--steps 0.015,0.024,0.032]
 //             [--seed-friction]   (slope rows with the seed's force-limited 1.2 N friction, see
 //                                  two_sbots_trials.h; the step rows are unaffected)
-//             [--track-mu MU]     (slope rows with Coulomb treels of coefficient MU instead of 1.0)
+//             [--track-mu MU]     (slope rows with Coulomb treels of coefficient MU instead of the
+//                                  polystyrene's 2.0, validation::kPolystyreneTrackMu)
 //             [--rear-uphill]     (slope rows facing downhill, climbing in reverse)
 //
 // The connection is the static front-gripper link (core/swarm/swarm_graph.h createStaticLink: fixed
@@ -75,7 +76,7 @@ int main(int argc, char** argv) {
   }
   sbot_tools::requireLevel("two_sbots", "--level " + level + " (or $SBOT_DESCRIPTION_DIR)", level);  // the default too
   const std::string friction = setup.seed_friction ? "seed (force limit 1.2 N per contact)"
-                               : "Coulomb (treels mu " + std::to_string(setup.track_mu > 0 ? setup.track_mu : 1.0).substr(0, 4) + ")";
+                               : "Coulomb (treels mu " + std::to_string(setup.track_mu > 0 ? setup.track_mu : sbot::validation::kPolystyreneTrackMu).substr(0, 4) + ")";
   std::printf("two_sbots: level %s, %d trials per cell, friction %s, %s\n\n", level.c_str(), trials, friction.c_str(),
               setup.rear_uphill ? "rear uphill (climbing in reverse)" : "front uphill");
   std::printf("Table 4.1 slope (stand 3 s, climb 8 s at 2.8 cm/s); label per trial (slide [mm], climb efficiency)\n");

@@ -37,6 +37,8 @@ SlopeResult pairSlope(const std::string& level, double angle, int trial, const S
     c.contact.material_mu["track"] = kSeedFrictionN;
   } else if (setup.track_mu > 0) {
     c.contact.material_mu["track"] = setup.track_mu;
+  } else {
+    validation::onPolystyrene(c);
   }
   validation::applyStudyKnobs(c);  // the solver study knobs, as sbot_validate
   World w(c);

@@ -25,7 +25,9 @@ struct SlopeSetup {
   /// true: both face downhill and climb in reverse (the single s-bot's matching orientation of
   /// Table 4.1, rear uphill); the holder is then above, gripping the robot below it.
   bool rear_uphill = false;
-  double track_mu = 0;         ///< > 0: Coulomb coefficient of the treels on the slope (default 1.0)
+  /// > 0: Coulomb coefficient of the treels on the slope; 0: Table 4.1's polystyrene
+  /// (validation::kPolystyreneTrackMu).
+  double track_mu = 0;
 };
 
 /// One s-bot or two connected s-bots on a slope of `angle` [rad] (tilted gravity): stand 3 s with

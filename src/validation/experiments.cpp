@@ -249,10 +249,13 @@ Outcome stepTrial(const std::string& level, double height_m, bool backward, int 
 
 // ---- Table 4.1: slope, hold then climb ------------------------------------------------------------
 
+void onPolystyrene(WorldConfig& c) { c.contact.material_mu["track"] = kPolystyreneTrackMu; }
+
 Outcome slopeHoldClimbTrial(const std::string& level, double angle_rad, bool backward, int trial) {
   const RobotDescription& d = loadLevel(level);
   Jitter j(std::string("slope") + (backward ? "b" : "f") + level, angle_rad, trial);
   WorldConfig c = configFor(d, 3000 + trial);
+  onPolystyrene(c);
   World w(c);
   // A tilted gravity is an infinite slope rising toward +x.
   const double g = c.gravity;

@@ -208,11 +208,15 @@ void Robot::build(const Pose& base_pose) {
 
   for (const auto& jn : d.treels.left_joints) left_hinges_.push_back(hinge_index_.at(jn));
   for (const auto& jn : d.treels.right_joints) right_hinges_.push_back(hinge_index_.at(jn));
-  for (const auto* side : {&left_hinges_, &right_hinges_}) {
-    for (int i : *side) {
+  for (int track : {0, 1}) {
+    for (int i : track == 0 ? left_hinges_ : right_hinges_) {
       const dBodyID wheel = bodies_[hinges_[i].child_body];
-      for (dGeomID g : geoms_)
-        if (dGeomGetBody(g) == wheel) static_cast<GeomInfo*>(dGeomGetData(g))->drive_wheel = true;
+      for (dGeomID g : geoms_) {
+        if (dGeomGetBody(g) != wheel) continue;
+        GeomInfo* info = static_cast<GeomInfo*>(dGeomGetData(g));
+        info->drive_wheel = true;
+        info->track = track;
+      }
     }
   }
   if (!d.turret.joint.empty()) turret_hinge_ = hinge_index_.at(d.turret.joint);
@@ -438,6 +442,19 @@ double Robot::trackSpeedRight() const {
   return right_hinges_.empty() ? 0 : sum / right_hinges_.size();
 }
 
+double Robot::trackCreepSlip(int track) const {
+  const TreelsSemantics& tr = description_->treels;
+  if (tr.creep_stiffness <= 0 || drive_linear_ || drive_contacts_ == 0 || drive_wheel_load_ <= 0) return 0;
+  // ODE lets a contact with force-dependent slip k slide at k x its friction force. The track's
+  // contacts share one slip velocity s |v|; with k = |v| n / (C N) for each of the n contacts
+  // carrying the load N, their friction forces add up to F = C N s, i.e. s = (F / N) / C however
+  // the load is shared among them. |v|: the track's speed, but no more than its motor is asked
+  // for, so that held tracks, which quickstep lets jitter, do not creep.
+  const double turning = std::fabs(track == 0 ? trackSpeedLeft() : trackSpeedRight());
+  const double speed = std::min(turning, std::fabs(motor_speed_[track]));
+  return speed * drive_contacts_ / (tr.creep_stiffness * drive_wheel_load_);
+}
+
 double Robot::encoderSpeed(int side) const {
   SensorSample sample{kTrackSpeedChannel, side, side == 0 ? trackSpeedLeft() : trackSpeedRight(), "", 0};
   for (const auto& e : world_.effects()) e->onSensor(*this, sample);
@@ -620,6 +637,8 @@ void Robot::applyCommands(double dt, const std::vector<EffectPtr>& effects) {
     drive(left_hinges_, cmd.left, cmd.max_torque_left);
     drive(right_hinges_, cmd.right, cmd.max_torque_right);
   }
+  motor_speed_[0] = passive_ ? 0.0 : cmd.left;
+  motor_speed_[1] = passive_ ? 0.0 : cmd.right;
   applyRollingResistance(cmd);
 
   if (turret_hinge_ >= 0) {

@@ -204,6 +204,7 @@ void parseSidecar(RobotDescription& d) {
   tr.rotor_inertia = get<double>(t, "rotor_inertia", tr.rotor_inertia, file, "treels.");
   tr.backdrive_force = get<double>(t, "backdrive_force", tr.backdrive_force, file, "treels.");
   tr.torque_window = get<double>(t, "torque_window", tr.torque_window, file, "treels.");
+  tr.creep_stiffness = get<double>(t, "creep_stiffness", tr.creep_stiffness, file, "treels.");
   // Every number below divides, scales or limits a motor: NaN, 0 or a sign error would silently
   // give a robot that cannot drive or one that explodes.
   const auto nonNegative = [&](double v, const std::string& field) {
@@ -220,6 +221,7 @@ void parseSidecar(RobotDescription& d) {
   nonNegative(tr.rotor_inertia, "treels.rotor_inertia");
   nonNegative(tr.backdrive_force, "treels.backdrive_force");
   nonNegative(tr.torque_window, "treels.torque_window");
+  nonNegative(tr.creep_stiffness, "treels.creep_stiffness");
   tr.drive = get<std::string>(t, "drive", tr.drive, file, "treels.");
   if (tr.drive != "wheels" && tr.drive != "body")
     throw ConfigError(file, "treels.drive", "expected 'wheels' or 'body', found '" + tr.drive + "'");

@@ -44,6 +44,20 @@ void nearCallback(void* data, dGeomID a, dGeomID b) { static_cast<World*>(data)-
 
 const GeomInfo* infoOf(dGeomID g) { return static_cast<const GeomInfo*>(dGeomGetData(g)); }
 
+/// Track creep (Robot::trackCreepSlip) as ODE's force-dependent slip along fdir1, on a terrain
+/// contact of a driven wheel where fdir1 (the heading in the contact plane) is the direction the
+/// wheel rolls in (axle x normal): floors, ramps, slopes. Not robot-robot contacts (no fdir1), nor a
+/// face the wheel is pressed against, where the heading's projection is a sideways remnant.
+void applyTrackCreep(const GeomInfo& wheel, const ContactContext& ctx, dSurfaceParameters& surface) {
+  if (ctx.fdir1.squaredNorm() == 0) return;
+  const Vec3 roll = (wheel.robot->basePose().orientation * Vec3::UnitY()).cross(ctx.normal);
+  if (roll.norm() < 0.5 || std::abs(roll.normalized().dot(ctx.fdir1)) < 0.95) return;
+  const double slip = wheel.robot->trackCreepSlip(wheel.track);
+  if (slip <= 0) return;
+  surface.mode |= dContactSlip1;
+  surface.slip1 = slip;
+}
+
 const std::string kGround = "ground";
 
 }  // namespace
@@ -315,6 +329,8 @@ void World::handlePair(dGeomID a, dGeomID b) {
     ctx.fdir1 = (!ba || !bb) ? ctx.heading : Vec3::Zero();
     contacts[i].surface = surface;
     for (const auto& e : effects_) e->onContact(ctx, contacts[i].surface);
+    if (ia && ia->track >= 0) applyTrackCreep(*ia, ctx, contacts[i].surface);
+    else if (ib && ib->track >= 0) applyTrackCreep(*ib, ctx, contacts[i].surface);
     if (ctx.fdir1.squaredNorm() > 0) {
       contacts[i].surface.mode |= dContactFDir1;
       for (int k = 0; k < 3; ++k) contacts[i].fdir1[k] = ctx.fdir1[k];

@@ -117,6 +117,12 @@ TEST(RobotDescription, MotorNumbersMustBeFiniteAndPositive) {
   BrokenCopy gravity;
   gravity.breakSidecar("gravity: 9.81", "gravity: -9.81");
   EXPECT_NE(gravity.loadError().find("field 'gravity': must be a finite number >= 0"), std::string::npos) << gravity.loadError();
+  for (const std::string bad : {".nan", "-1"}) {
+    BrokenCopy creep;
+    creep.breakSidecar("creep_stiffness: 5.6", "creep_stiffness: " + bad);
+    EXPECT_NE(creep.loadError().find("field 'treels.creep_stiffness': must be a finite number >= 0"), std::string::npos)
+        << bad << ": " << creep.loadError();
+  }
 }
 
 TEST(RobotDescription, TheTurretCannotBeADrivenWheel) {

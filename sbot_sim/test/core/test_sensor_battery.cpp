@@ -90,8 +90,13 @@ TEST(Battery, DrivingDrawsMotorPowerAndTheVoltageSags) {
   EXPECT_LT(driving.energyUsed(), 5.0 * 60) << "within the seed's 5 W budget";
   EXPECT_LT(driving.stateOfCharge(), 1.0);
   EXPECT_THROW(driving.setStateOfCharge(1.5), std::invalid_argument);
+  // At 50 % charge the pack's open-circuit voltage is 7.64 V; under the last step's load it sags by
+  // I R (0.15 ohm). That load jitters from step to step in a spin (3-7.5 W), so it is bounded, not
+  // pinned: up to 8 W, 0.16 V.
   driving.setStateOfCharge(0.5);
-  EXPECT_NEAR(driving.voltage(), 7.64, 0.1);
+  EXPECT_GT(driving.power(), 2.5);
+  EXPECT_NEAR(driving.voltage(), 7.64 - driving.power() / 7.64 * 0.15, 1e-9);
+  EXPECT_LT(driving.power(), 8.0);
 }
 
 }  // namespace

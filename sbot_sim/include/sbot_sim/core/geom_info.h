@@ -13,6 +13,7 @@ struct GeomInfo {
   std::string material;          ///< contact material / optical surface label
   std::string link;              ///< URDF link (robots) or obstacle name (static geometry)
   bool drive_wheel = false;      ///< on a driven treels wheel (Robot::driveWheelLoad measures its contacts)
+  int track = -1;                ///< the driven wheel's track: 0 left, 1 right; -1 for any other geom
 };
 
 }  // namespace sbot

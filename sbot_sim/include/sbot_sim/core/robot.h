@@ -147,6 +147,7 @@ class Robot {
   void applyCommands(double dt, const std::vector<EffectPtr>& effects);
   void readFeedback(double dt);
   void clearDriveContacts() {
+    drive_contacts_ = 0;
     drive_wheel_load_ = 0;
     drive_contact_force_ = Vec3::Zero();
   }
@@ -154,7 +155,12 @@ class Robot {
   void addDriveContact(double push, const Vec3& force) {
     drive_wheel_load_ += push;
     drive_contact_force_ += force;
+    ++drive_contacts_;
   }
+  /// Track creep (treels.creep_stiffness) as ODE's force-dependent slip for one terrain contact of
+  /// a driven wheel of `track` (0 left, 1 right) [m/s per N]; 0 when the level has no creep, uses
+  /// the body drive, the track stands or nothing carried the wheels in the last step.
+  double trackCreepSlip(int track) const;
   dBodyID baseBody() const;
   dSpaceID space() const { return space_; }
   const std::vector<dBodyID>& bodies() const { return bodies_; }
@@ -230,6 +236,8 @@ class Robot {
   double track_width_ = 0.082;           ///< [m] see trackWidth()
   bool wheels_apart_ = false;            ///< the model's driven wheels give the track width
 
+  int drive_contacts_ = 0;               ///< contacts behind drive_wheel_load_ (last step)
+  double motor_speed_[2] = {0, 0};       ///< [m/s] the tracks' motor targets this step (0 when passive)
   double drive_wheel_load_ = 0;          ///< [N] see driveWheelLoad()
   Vec3 drive_contact_force_ = Vec3::Zero();  ///< [N] see driveContactForce()
   double req_left_ = 0, req_right_ = 0;  ///< requested track speeds [m/s]

@@ -56,6 +56,10 @@ struct TreelsSemantics {
   double rotor_inertia = 0;          ///< [kg m^2] of one track motor's rotor (reflected: x gear^2)
   double backdrive_force = 1.2;      ///< [N] to pull the whole robot with its motors off (passive)
   double torque_window = 0.1;        ///< [s] getTrackTorque reports the mean motor torque over this window
+  /// Track creep: a driven track slips back over the terrain at the slip ratio (F/N) / this of its
+  /// own speed, F/N its traction ratio (World applies it to the driven wheels' terrain contacts).
+  /// Dimensionless; 0 = no creep. Wheel drives only.
+  double creep_stiffness = 0;
   /// "wheels": a velocity motor on every driven hinge (wheel-ground contacts carry the robot);
   /// "body": the tracks drive the chassis directly as an ideal differential drive (Robot, Fast).
   std::string drive = "wheels";
