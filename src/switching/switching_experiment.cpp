@@ -6,7 +6,8 @@
 //
 //   switching_experiment [--scenario config/scenarios/composite_course_switching.yaml]
 //                        [--route <scenario>.route.yaml] [--runs 10] [--out DIR]
-//                        [--modes detailed,switching]   (any level name: that level only) [--jobs 2] [--small-gap-max 0.04]
+//                        [--modes detailed,switching]   (any level name: that level only) [--jobs 2]
+//                        [--small-gap-max 0.032] [--lookahead 0.14] [--demote-delay 0.3]
 //
 // Each mode runs in its own child process (--jobs 2: both at once; --jobs 1: one after the other),
 // so a mode's timing is that process's alone. Run k of either mode uses world seed 1000 + k and the
@@ -64,8 +65,9 @@ struct Options {
   int runs = 10;
   int jobs = 2;
   std::vector<std::string> modes{"detailed", "switching"};
-  double small_gap_max = 0.04;
-  double lookahead = -1, demote_delay = -1;  // < 0: LevelPolicyConfig defaults
+  // Policy settings: CourseRunConfig's defaults (why: see there).
+  double small_gap_max = CourseRunConfig{}.small_gap_max;
+  double lookahead = CourseRunConfig{}.lookahead, demote_delay = CourseRunConfig{}.demote_delay;
   double policy_rate = 5;  // [Hz]
 };
 
@@ -135,7 +137,7 @@ int main(int argc, char** argv) {
     else if (a == "--out") o.out = args.value();
     else if (a == "--jobs") o.jobs = args.count(1, 64);
     else if (a == "--small-gap-max") o.small_gap_max = args.number(0, 1);
-    else if (a == "--lookahead") o.lookahead = args.number(0, 10);
+    else if (a == "--lookahead") o.lookahead = args.number(0.01, 10);
     else if (a == "--demote-delay") o.demote_delay = args.number(0, 1000);
     else if (a == "--modes") {
       o.modes.clear();
@@ -143,7 +145,8 @@ int main(int argc, char** argv) {
       for (std::string m; std::getline(ss, m, ',');) o.modes.push_back(m);
     } else {
       std::fprintf(stderr, "usage: switching_experiment [--scenario F] [--route F] [--runs N] [--out DIR] "
-                           "[--modes detailed,switching] [--jobs 2] [--small-gap-max M]\n");
+                           "[--modes detailed,switching] [--jobs 2] [--small-gap-max M] [--lookahead M] "
+                           "[--demote-delay S]\n");
       return a == "--help" ? 0 : 2;
     }
   }
