@@ -65,10 +65,7 @@ struct Options {
   int runs = 10;
   int jobs = 2;
   std::vector<std::string> modes{"detailed", "switching"};
-  // Policy settings: CourseRunConfig's defaults (why: see there).
-  double small_gap_max = CourseRunConfig{}.small_gap_max;
-  double lookahead = CourseRunConfig{}.lookahead, demote_delay = CourseRunConfig{}.demote_delay;
-  double policy_rate = 5;  // [Hz]
+  CourseRunConfig course;  // the policy's settings (defaults and why: see there); path_csv set per run
 };
 
 void runMode(const Options& o, const std::string& mode) {
@@ -77,11 +74,7 @@ void runMode(const Options& o, const std::string& mode) {
   std::ofstream sum(o.out + "/" + mode + "_summary.csv");
   sum << "run,reached,end,sim_s,wall_s,cpu_s,final_x,final_y,switches,basic_s,medium_s,detailed_s\n";
   for (int k = 0; k < o.runs; ++k) {
-    CourseRunConfig rc;
-    rc.small_gap_max = o.small_gap_max;
-    rc.lookahead = o.lookahead;
-    rc.demote_delay = o.demote_delay;
-    rc.policy_rate = o.policy_rate;
+    CourseRunConfig rc = o.course;
     rc.path_csv = o.out + "/" + mode + "_run" + std::to_string(k) + ".csv";
     const RunResult r = runCourse(rc, sc, route, mode, k);
     auto lt = [&](const char* l) { auto it = r.level_time.find(l); return it == r.level_time.end() ? 0.0 : it->second; };
@@ -136,9 +129,9 @@ int main(int argc, char** argv) {
     else if (a == "--runs") o.runs = args.count(1, 1000);
     else if (a == "--out") o.out = args.value();
     else if (a == "--jobs") o.jobs = args.count(1, 64);
-    else if (a == "--small-gap-max") o.small_gap_max = args.number(0, 1);
-    else if (a == "--lookahead") o.lookahead = args.number(0.01, 10);
-    else if (a == "--demote-delay") o.demote_delay = args.number(0, 1000);
+    else if (a == "--small-gap-max") o.course.small_gap_max = args.number(0, 1);
+    else if (a == "--lookahead") o.course.lookahead = args.number(0.01, 10);
+    else if (a == "--demote-delay") o.course.demote_delay = args.number(0, 1000);
     else if (a == "--modes") {
       o.modes.clear();
       std::stringstream ss(args.value());

@@ -48,9 +48,10 @@ const GeomInfo* infoOf(dGeomID g) { return static_cast<const GeomInfo*>(dGeomGet
 /// contact of a driven wheel where fdir1 (the heading in the contact plane) is the direction the
 /// wheel rolls in (axle x normal): floors, ramps, slopes. Not robot-robot contacts (no fdir1), nor a
 /// face the wheel is pressed against, where the heading's projection is a sideways remnant.
-void applyTrackCreep(const GeomInfo& wheel, const ContactContext& ctx, dSurfaceParameters& surface) {
+/// `axle`: the wheel's robot's lateral axis (its wheels' axles) in world coordinates.
+void applyTrackCreep(const GeomInfo& wheel, const Vec3& axle, const ContactContext& ctx, dSurfaceParameters& surface) {
   if (ctx.fdir1.squaredNorm() == 0) return;
-  const Vec3 roll = (wheel.robot->basePose().orientation * Vec3::UnitY()).cross(ctx.normal);
+  const Vec3 roll = axle.cross(ctx.normal);
   if (roll.norm() < 0.5 || std::abs(roll.normalized().dot(ctx.fdir1)) < 0.95) return;
   const double slip = wheel.robot->trackCreepSlip(wheel.track);
   if (slip <= 0) return;
@@ -316,7 +317,10 @@ void World::handlePair(dGeomID a, dGeomID b) {
   surface.bounce = cc.bounce;
   surface.bounce_vel = 0.05;
   const Robot* mover = ctx.robot_a ? ctx.robot_a : ctx.robot_b;
-  const Vec3 heading = mover ? Vec3(mover->basePose().orientation * Vec3::UnitX()) : Vec3::Zero();
+  // With fdir1 set (a robot against static geometry) the mover is also the wheels' robot.
+  const Quat orientation = mover ? mover->basePose().orientation : Quat::Identity();
+  const Vec3 heading = mover ? Vec3(orientation * Vec3::UnitX()) : Vec3::Zero();
+  const Vec3 axle = orientation * Vec3::UnitY();
   for (int i = 0; i < n; ++i) {
     ctx.normal = Vec3(contacts[i].geom.normal[0], contacts[i].geom.normal[1], contacts[i].geom.normal[2]);
     const Vec3 along = heading - heading.dot(ctx.normal) * ctx.normal;
@@ -329,8 +333,8 @@ void World::handlePair(dGeomID a, dGeomID b) {
     ctx.fdir1 = (!ba || !bb) ? ctx.heading : Vec3::Zero();
     contacts[i].surface = surface;
     for (const auto& e : effects_) e->onContact(ctx, contacts[i].surface);
-    if (ia && ia->track >= 0) applyTrackCreep(*ia, ctx, contacts[i].surface);
-    else if (ib && ib->track >= 0) applyTrackCreep(*ib, ctx, contacts[i].surface);
+    if (ia && ia->track >= 0) applyTrackCreep(*ia, axle, ctx, contacts[i].surface);
+    else if (ib && ib->track >= 0) applyTrackCreep(*ib, axle, ctx, contacts[i].surface);
     if (ctx.fdir1.squaredNorm() > 0) {
       contacts[i].surface.mode |= dContactFDir1;
       for (int k = 0; k < 3; ++k) contacts[i].fdir1[k] = ctx.fdir1[k];

@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include <cmath>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -508,23 +509,33 @@ TEST(TreelsFast, PassiveFastRobotHoldsBelowItsScaledBackDriveForce) {
 
 // ---- Track creep (treels.creep_stiffness) ---------------------------------------------------------
 
-/// A Detailed s-bot on an infinite slope of `deg` (gravity tilted; treels mu 2, so they do not
-/// slide), facing uphill: progress along the slope over `climb_s` at `units` after 1 s to get going,
-/// as a fraction of the commanded distance. Without creep when `creep` is false.
+/// A world whose gravity is tilted by `deg` (an infinite slope rising toward +x), with treels mu 2
+/// so that they do not slide, holding one Detailed s-bot facing uphill; without creep when `creep`
+/// is false. Keeps the description the robot points to.
+struct DetailedOnSlope {
+  RobotDescription description;
+  std::unique_ptr<World> world;
+  Robot* robot = nullptr;
+  DetailedOnSlope(double deg, bool creep) : description(loadLevel("detailed")) {
+    if (!creep) description.treels.creep_stiffness = 0;
+    WorldConfig c = flatWorld();
+    c.contact.material_mu["track"] = 2.0;
+    world = std::make_unique<World>(c);
+    const double a = deg * M_PI / 180;
+    dWorldSetGravity(world->odeWorld(), -c.gravity * std::sin(a), 0, -c.gravity * std::cos(a));
+    robot = &world->addRobot(description, {0, 0, 0}, "sbot_0");
+  }
+};
+
+/// Progress along the slope over `climb_s` at `units` after 1 s to get going, as a fraction of the
+/// commanded distance.
 double climbEfficiency(double deg, int units, bool creep, double climb_s = 4.0) {
-  RobotDescription d = loadLevel("detailed");
-  if (!creep) d.treels.creep_stiffness = 0;
-  WorldConfig c = flatWorld();
-  c.contact.material_mu["track"] = 2.0;
-  World w(c);
-  const double a = deg * M_PI / 180;
-  dWorldSetGravity(w.odeWorld(), -c.gravity * std::sin(a), 0, -c.gravity * std::cos(a));
-  Robot& r = w.addRobot(d, {0, 0, 0}, "sbot_0");
-  r.setSpeed(units, units);
-  runFor(w, 1.0);
-  const double x0 = r.basePose().position.x();
-  runFor(w, climb_s);
-  return (r.basePose().position.x() - x0) / (units * d.treels.speed_unit * climb_s);
+  DetailedOnSlope s(deg, creep);
+  s.robot->setSpeed(units, units);
+  runFor(*s.world, 1.0);
+  const double x0 = s.robot->basePose().position.x();
+  runFor(*s.world, climb_s);
+  return (s.robot->basePose().position.x() - x0) / (units * s.description.treels.speed_unit * climb_s);
 }
 
 TEST(TrackCreep, ClimbingTracksSlipByTheirTractionRatioOverTheCreepStiffness) {
@@ -549,19 +560,12 @@ TEST(TrackCreep, StandingTracksDoNotCreep) {
   // stands as it does without. (Both settle by a few mm: quickstep's own creep under load.)
   double moved[2];
   for (bool creep : {true, false}) {
-    RobotDescription d = loadLevel("detailed");
-    if (!creep) d.treels.creep_stiffness = 0;
-    WorldConfig c = flatWorld();
-    c.contact.material_mu["track"] = 2.0;
-    World w(c);
-    const double a = 40 * M_PI / 180;
-    dWorldSetGravity(w.odeWorld(), -c.gravity * std::sin(a), 0, -c.gravity * std::cos(a));
-    Robot& r = w.addRobot(d, {0, 0, 0}, "sbot_0");
-    r.setSpeed(0, 0);
-    runFor(w, 0.5);
-    const double x0 = r.basePose().position.x();
-    runFor(w, 3.0);
-    moved[creep] = r.basePose().position.x() - x0;
+    DetailedOnSlope s(40, creep);
+    s.robot->setSpeed(0, 0);
+    runFor(*s.world, 0.5);
+    const double x0 = s.robot->basePose().position.x();
+    runFor(*s.world, 3.0);
+    moved[creep] = s.robot->basePose().position.x() - x0;
   }
   // 3.4 mm both; a creep acting on held tracks (their load is F/N = tan 40 deg) adds ~1 cm, and
   // one taking the speed of the held, jittering wheels (not bounded by the motor's) 0.6 mm.
