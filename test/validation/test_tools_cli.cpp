@@ -89,6 +89,9 @@ TEST(ToolsCli, UnknownSectionsAndUnreadableHeightMapsAreRefusedBeforeAnyRun) {
   expectRefused("sbot_validate", out + "--only fig44", "--only: unknown section 'fig44' (sections: facts, 4.1");
   expectRefused("sbot_validate", out + "--only fig4.4 --heightmap /nonexistent/map.png",
                 "--heightmap (or $SBOT_HEIGHTMAP): /nonexistent/map.png: field 'terrain.heightmap_image': cannot read image");
+  // A report whose mismatches could not be explained is not written either.
+  expectRefused("sbot_validate", out + "--only 4.2 --reasons /nonexistent/reasons.yaml",
+                "sbot_validate: --reasons: mismatch reasons /nonexistent/reasons.yaml: cannot be read");
 }
 
 // A model description that cannot be read ($SBOT_DESCRIPTION_DIR, the sweep tool's variants): two_sbots

@@ -1,10 +1,10 @@
 // The decisive cells of the seed's hardware validation (Tables 4.1-4.3) on the Detailed model, one
 // trial each, run in 2 processes (~10 s). The full suite with 12 trials per cell is `sbot_validate`.
 //
-// Cells the current model does not match yet (see src/validation/README.md, "Why cells do not
-// match") are listed in kKnownMismatch: for them the test prints the outcome but does not fail, so
-// that the suite guards every matched cell against regressions. When a known cell starts to match,
-// the test says so: remove it from the list.
+// Cells the current model does not match yet have a recorded reason in
+// config/validation/mismatch_reasons.yaml (the report prints it under the cell): for them the test
+// prints the outcome but does not fail, so that the suite guards every matched cell against
+// regressions. When such a cell starts to match, the test says so: remove its reason.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "experiments.h"
+#include "mismatch_reasons.h"
 
 namespace v = sbot::validation;
 
@@ -26,34 +27,34 @@ struct Cell {
   std::function<v::Outcome()> run;
 };
 
-// Our Detailed model climbs ~26 mm forward, crosses 55 mm gaps (the held front gripper props it on
-// the far edge), and tips forward onto its gripper when it reverses up any step from 10 mm: see
-// the README.
-const std::set<std::string> kKnownMismatch{"gap 55 mm (Table 4.2)", "step 24 mm forward (Table 4.3)",
-                                           "step 15 mm backward (Table 4.3)"};
+/// The cells the validation report explains as not matching (the same file sbot_validate reads).
+v::MismatchReasons knownMismatches() {
+  return v::MismatchReasons::load(std::string(SWARMBOT3D_SOURCE_DIR) + "/config/validation/mismatch_reasons.yaml");
+}
 
 }  // namespace
 
 TEST(ValidationDecisive, HardwareCells) {
   const std::vector<Cell> cells{
-      {"gap 45 mm (Table 4.2)", "pass", [] { return v::gapTrial("detailed", 0.045, 0); }},
-      {"gap 55 mm (Table 4.2)", "stuck", [] { return v::gapTrial("detailed", 0.055, 0); }},
-      {"step 15 mm forward (Table 4.3)", "pass", [] { return v::stepTrial("detailed", 0.015, false, 0); }},
-      {"step 23 mm forward (Table 4.3)", "pass", [] { return v::stepTrial("detailed", 0.023, false, 0); }},
-      {"step 24 mm forward (Table 4.3)", "fail", [] { return v::stepTrial("detailed", 0.024, false, 0); }},
-      {"step 15 mm backward (Table 4.3)", "pass", [] { return v::stepTrial("detailed", 0.015, true, 0); }},
-      {"step 16 mm backward (Table 4.3)", "fail", [] { return v::stepTrial("detailed", 0.016, true, 0); }},
-      {"slope 30 deg, rear uphill (Table 4.1)", "topple b/w",
+      {"4.2 45 mm", "pass", [] { return v::gapTrial("detailed", 0.045, 0); }},
+      {"4.2 55 mm", "stuck", [] { return v::gapTrial("detailed", 0.055, 0); }},
+      {"4.3 15 mm forward", "pass", [] { return v::stepTrial("detailed", 0.015, false, 0); }},
+      {"4.3 23 mm forward", "pass", [] { return v::stepTrial("detailed", 0.023, false, 0); }},
+      {"4.3 24 mm forward", "fail", [] { return v::stepTrial("detailed", 0.024, false, 0); }},
+      {"4.3 15 mm backward", "pass", [] { return v::stepTrial("detailed", 0.015, true, 0); }},
+      {"4.3 16 mm backward", "fail", [] { return v::stepTrial("detailed", 0.016, true, 0); }},
+      {"4.1 30 deg rear uphill", "topple b/w",
        [] { return v::slopeHoldClimbTrial("detailed", 30 * M_PI / 180, true, 0); }},
   };
+  const v::MismatchReasons known_mismatches = knownMismatches();
   const auto res = v::runParallel(static_cast<int>(cells.size()), 2, [&](int i) { return cells[i].run(); });
   for (std::size_t i = 0; i < cells.size(); ++i) {
     std::string got = res[i].label;
     if (cells[i].expect == "fail" && got == "topple") got = "fail";  // toppling off a step fails it
-    const bool known = kKnownMismatch.count(cells[i].what) != 0;
-    std::printf("[decisive] %-40s seed %-11s ours %-11s %s\n", cells[i].what.c_str(), cells[i].expect.c_str(),
+    const bool known = known_mismatches.explains(cells[i].what);
+    std::printf("[decisive] %-24s seed %-11s ours %-11s %s\n", cells[i].what.c_str(), cells[i].expect.c_str(),
                 res[i].label.c_str(),
-                got == cells[i].expect ? (known ? "MATCH (now matches: remove from kKnownMismatch)" : "match")
+                got == cells[i].expect ? (known ? "MATCH (now matches: remove its reason)" : "match")
                                        : (known ? "known mismatch" : "MISMATCH"));
     EXPECT_NE(res[i].label, "error") << cells[i].what;
     if (!known) {
