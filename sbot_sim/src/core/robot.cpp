@@ -442,17 +442,19 @@ double Robot::trackSpeedRight() const {
   return right_hinges_.empty() ? 0 : sum / right_hinges_.size();
 }
 
-double Robot::trackCreepSlip(int track) const {
+void Robot::updateCreepSlip(const TrackCommand& cmd) {
+  creep_slip_[0] = creep_slip_[1] = 0;
   const TreelsSemantics& tr = description_->treels;
-  if (tr.creep_stiffness <= 0 || drive_linear_ || drive_contacts_ == 0 || drive_wheel_load_ <= 0) return 0;
+  if (tr.creep_stiffness <= 0 || drive_linear_ || passive_ || drive_contacts_ == 0 || drive_wheel_load_ <= 0) return;
   // ODE lets a contact with force-dependent slip k slide at k x its friction force. The track's
   // contacts share one slip velocity s |v|; with k = |v| n / (C N) for each of the n contacts
   // carrying the load N, their friction forces add up to F = C N s, i.e. s = (F / N) / C however
   // the load is shared among them. |v|: the track's speed, but no more than its motor is asked
   // for, so that held tracks, which quickstep lets jitter, do not creep.
-  const double turning = std::fabs(track == 0 ? trackSpeedLeft() : trackSpeedRight());
-  const double speed = std::min(turning, std::fabs(motor_speed_[track]));
-  return speed * drive_contacts_ / (tr.creep_stiffness * drive_wheel_load_);
+  const double turning[2] = {std::fabs(trackSpeedLeft()), std::fabs(trackSpeedRight())};
+  const double motor[2] = {std::fabs(cmd.left), std::fabs(cmd.right)};
+  for (int track : {0, 1})
+    creep_slip_[track] = std::min(turning[track], motor[track]) * drive_contacts_ / (tr.creep_stiffness * drive_wheel_load_);
 }
 
 double Robot::encoderSpeed(int side) const {
@@ -637,8 +639,7 @@ void Robot::applyCommands(double dt, const std::vector<EffectPtr>& effects) {
     drive(left_hinges_, cmd.left, cmd.max_torque_left);
     drive(right_hinges_, cmd.right, cmd.max_torque_right);
   }
-  motor_speed_[0] = passive_ ? 0.0 : cmd.left;
-  motor_speed_[1] = passive_ ? 0.0 : cmd.right;
+  updateCreepSlip(cmd);  // once per step, for every terrain contact of the wheels that collision makes
   applyRollingResistance(cmd);
 
   if (turret_hinge_ >= 0) {

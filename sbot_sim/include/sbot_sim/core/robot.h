@@ -160,7 +160,7 @@ class Robot {
   /// Track creep (treels.creep_stiffness) as ODE's force-dependent slip for one terrain contact of
   /// a driven wheel of `track` (0 left, 1 right) [m/s per N]; 0 when the level has no creep, uses
   /// the body drive, the track stands or nothing carried the wheels in the last step.
-  double trackCreepSlip(int track) const;
+  double trackCreepSlip(int track) const { return creep_slip_[track]; }
   dBodyID baseBody() const;
   dSpaceID space() const { return space_; }
   const std::vector<dBodyID>& bodies() const { return bodies_; }
@@ -199,6 +199,8 @@ class Robot {
   void buildBodyDrive();
   void applyBodyDrive(const TrackCommand& cmd);
   void applyRollingResistance(const TrackCommand& cmd);  ///< TrackCommand::resist_torque_*
+  /// trackCreepSlip for this step, from the motor targets in `cmd` and the last step's wheel loads.
+  void updateCreepSlip(const TrackCommand& cmd);
   /// Track surface speed [m/s] the body drive sees: forward speed -/+ yaw rate * width / 2.
   double bodyDriveTrackSpeed(int side) const;
   void addReflectedRotorInertia(const std::vector<int>& track);
@@ -237,7 +239,7 @@ class Robot {
   bool wheels_apart_ = false;            ///< the model's driven wheels give the track width
 
   int drive_contacts_ = 0;               ///< contacts behind drive_wheel_load_ (last step)
-  double motor_speed_[2] = {0, 0};       ///< [m/s] the tracks' motor targets this step (0 when passive)
+  double creep_slip_[2] = {0, 0};        ///< see trackCreepSlip(); set by updateCreepSlip each step
   double drive_wheel_load_ = 0;          ///< [N] see driveWheelLoad()
   Vec3 drive_contact_force_ = Vec3::Zero();  ///< [N] see driveContactForce()
   double req_left_ = 0, req_right_ = 0;  ///< requested track speeds [m/s]
