@@ -14,6 +14,9 @@
 namespace sbot {
 namespace validation {
 
+/// The reasons file, relative to the root package (the swarmbot3d source directory).
+constexpr const char* kMismatchReasonsFile = "config/validation/mismatch_reasons.yaml";
+
 class MismatchReasons {
  public:
   MismatchReasons() = default;

@@ -188,8 +188,6 @@ void writeProfile(std::ostream& md, bool quick) {
   md << "\n";
 }
 
-constexpr const char* kReasonsFile = "config/validation/mismatch_reasons.yaml";
-
 std::string findHeightmap() {
   const char* env = std::getenv("SBOT_HEIGHTMAP");
   if (env) return env;
@@ -276,7 +274,8 @@ int main(int argc, char** argv) {
     }
   }
   try {  // before any work: a report whose mismatches cannot be explained is not written
-    reasons = o.reasons.empty() ? v::MismatchReasons::load(std::string(SWARMBOT3D_SOURCE_DIR) + "/" + kReasonsFile, kReasonsFile)
+    reasons = o.reasons.empty() ? v::MismatchReasons::load(std::string(SWARMBOT3D_SOURCE_DIR) + "/" + v::kMismatchReasonsFile,
+                                                            v::kMismatchReasonsFile)
                                 : v::MismatchReasons::load(o.reasons);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "sbot_validate: --reasons: %s\n", e.what());

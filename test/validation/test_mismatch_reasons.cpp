@@ -94,7 +94,7 @@ TEST(MismatchReasons, MalformedFilesAreRefusedWithTheFileAndTheProblem) {
 TEST(MismatchReasons, TheShippedFileNamesCellsAsTheReportDoes) {
   // Every key is "<table> <cell>" with a table the report tallies, so that a typo cannot hide a
   // reason from its cell (the report would then call the cell unexplained and the entry unused).
-  const std::string path = std::string(SWARMBOT3D_SOURCE_DIR) + "/config/validation/mismatch_reasons.yaml";
+  const std::string path = std::string(SWARMBOT3D_SOURCE_DIR) + "/" + v::kMismatchReasonsFile;
   v::MismatchReasons r = v::MismatchReasons::load(path);
   const YAML::Node root = YAML::LoadFile(path);
   ASSERT_TRUE(root.IsMap());

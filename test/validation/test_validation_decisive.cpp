@@ -29,7 +29,7 @@ struct Cell {
 
 /// The cells the validation report explains as not matching (the same file sbot_validate reads).
 v::MismatchReasons knownMismatches() {
-  return v::MismatchReasons::load(std::string(SWARMBOT3D_SOURCE_DIR) + "/config/validation/mismatch_reasons.yaml");
+  return v::MismatchReasons::load(std::string(SWARMBOT3D_SOURCE_DIR) + "/" + v::kMismatchReasonsFile);
 }
 
 }  // namespace
