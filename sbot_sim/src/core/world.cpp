@@ -344,7 +344,8 @@ void World::handlePair(dGeomID a, dGeomID b) {
     dJointAttach(c, ba, bb);
     const bool wheel_a = ia && ia->drive_wheel, wheel_b = ib && ib->drive_wheel;
     if (wheel_a || wheel_b) {
-      wheel_contacts_.push_back({{}, ctx.normal, wheel_a ? ia->robot : nullptr, wheel_b ? ib->robot : nullptr, ba == nullptr});
+      wheel_contacts_.push_back({{}, ctx.normal, wheel_a ? ia->robot : nullptr, wheel_b ? ib->robot : nullptr, ba == nullptr,
+                                 wheel_a && ia->track >= 0, wheel_b && ib->track >= 0});
       dJointSetFeedback(c, &wheel_contacts_.back().feedback);
     }
   }
@@ -352,17 +353,17 @@ void World::handlePair(dGeomID a, dGeomID b) {
 
 void World::updateDriveWheelLoads() {
   for (auto& r : robots_) r->clearDriveContacts();
-  auto add = [](Robot* r, const dVector3 force, double sign, const Vec3& normal) {
+  auto add = [](Robot* r, const dVector3 force, double sign, const Vec3& normal, bool wheel) {
     const Vec3 f(force[0], force[1], force[2]);
     const double push = sign * f.dot(normal);
-    if (r && push > 0) r->addDriveContact(push, f);
+    if (r && push > 0) r->addDriveContact(push, f, wheel);
   };
   for (const WheelContact& w : wheel_contacts_) {
     // The contact normal points from geom 2 into geom 1: body 1 is pushed along it, body 2
     // against it. A contact whose body 1 is static is stored reversed by ODE: its body 2's force
     // is reported in f1.
-    add(w.wheel_of_body1, w.feedback.f1, 1.0, w.normal);
-    add(w.wheel_of_body2, w.body1_static ? w.feedback.f1 : w.feedback.f2, -1.0, w.normal);
+    add(w.wheel_of_body1, w.feedback.f1, 1.0, w.normal, w.on_wheel1);
+    add(w.wheel_of_body2, w.body1_static ? w.feedback.f1 : w.feedback.f2, -1.0, w.normal, w.on_wheel2);
   }
   wheel_contacts_.clear();
 }

@@ -439,6 +439,29 @@ TEST(TreelsFast, AccelerationIsTractionLimitedAndTorqueIsRead) {
   EXPECT_NEAR(tl, tr, 10) << "straight: the yaw motor only holds small disturbances";
 }
 
+TEST(TreelsFast, AHardStartRearsTheRobotOnItsMotorsReactionAndItDropsBack) {
+  // The body drive pushes at the chassis' centre; the wheel motors' reaction (push x wheel radius,
+  // Robot::applyDriveReaction) pitches the nose up while the robot accelerates at its traction
+  // limit. With its centre of mass over the wheels and 2.25 cm high, the rear caster 2 cm behind,
+  // the reaction alone would flip it (mu h > d); the wheels lifting off end it, so it drops back.
+  World w(fastWorld());
+  Robot& r = w.addRobot(loadLevel("fast"), {0, 0, 0}, "sbot_0");
+  runFor(w, 0.5);
+  auto nose_up_deg = [&] { return std::asin((r.basePose().orientation * Vec3::UnitX()).z()) * 180 / M_PI; };
+  EXPECT_NEAR(nose_up_deg(), 0.0, 1.0) << "level at rest";
+  r.setSpeed(70, 70);
+  double most = -90;
+  for (int i = 0; i < 10; ++i) {  // 1 s of accelerating
+    w.step();
+    most = std::max(most, nose_up_deg());
+  }
+  EXPECT_GT(most, 3.0) << "the motors' reaction rears it";
+  EXPECT_LT(most, 20.0) << "but does not flip it";
+  runFor(w, 3.0);
+  EXPECT_NEAR(nose_up_deg(), 0.0, 2.0) << "back on its wheels at steady speed";
+  EXPECT_NEAR(r.linearVelocity().x(), 70 * 0.0028, 0.01);
+}
+
 TEST(TreelsFast, NoPushWhileAirborne) {
   // The drive's traction is the tracks' load: lifted off the ground (by a hand, another robot's
   // gripper, over a cliff) the robot must not fly along its heading.

@@ -148,14 +148,17 @@ class Robot {
   void readFeedback(double dt);
   void clearDriveContacts() {
     drive_contacts_ = 0;
+    driven_wheel_contacts_ = 0;
     drive_wheel_load_ = 0;
     drive_contact_force_ = Vec3::Zero();
   }
-  /// One contact on a drive geom: its push along the contact normal [N] and its force vector [N].
-  void addDriveContact(double push, const Vec3& force) {
+  /// One contact on a drive geom: its push along the contact normal [N], its force vector [N], and
+  /// whether the geom is a driven wheel (the body drive's chassis and casters are drive geoms too).
+  void addDriveContact(double push, const Vec3& force, bool on_wheel) {
     drive_wheel_load_ += push;
     drive_contact_force_ += force;
     ++drive_contacts_;
+    if (on_wheel) ++driven_wheel_contacts_;
   }
   /// Track creep (treels.creep_stiffness) as ODE's force-dependent slip for one terrain contact of
   /// a driven wheel of `track` (0 left, 1 right) [m/s per N]; 0 when the level has no creep, uses
@@ -198,6 +201,7 @@ class Robot {
   void measureTrackWidth();
   void buildBodyDrive();
   void applyBodyDrive(const TrackCommand& cmd);
+  void applyDriveReaction();
   void applyRollingResistance(const TrackCommand& cmd);  ///< TrackCommand::resist_torque_*
   /// trackCreepSlip for this step, from the motor targets in `cmd` and the last step's wheel loads.
   void updateCreepSlip(const TrackCommand& cmd);
@@ -239,6 +243,7 @@ class Robot {
   bool wheels_apart_ = false;            ///< the model's driven wheels give the track width
 
   int drive_contacts_ = 0;               ///< contacts behind drive_wheel_load_ (last step)
+  int driven_wheel_contacts_ = 0;        ///< of those, on the driven wheels themselves (see applyDriveReaction)
   double creep_slip_[2] = {0, 0};        ///< see trackCreepSlip(); set by updateCreepSlip each step
   double drive_wheel_load_ = 0;          ///< [N] see driveWheelLoad()
   Vec3 drive_contact_force_ = Vec3::Zero();  ///< [N] see driveContactForce()

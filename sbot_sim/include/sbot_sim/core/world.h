@@ -137,6 +137,7 @@ class World {
     Robot* wheel_of_body1 = nullptr;  ///< the robot whose driven wheel is the contact's body 1
     Robot* wheel_of_body2 = nullptr;
     bool body1_static = false;        ///< ODE then stores the joint reversed (see updateDriveWheelLoads)
+    bool on_wheel1 = false, on_wheel2 = false;  ///< the geom is a driven wheel itself, not the body drive's chassis
   };
   std::deque<WheelContact> wheel_contacts_;
   void updateDriveWheelLoads();       ///< after the step: sum the normal forces per robot
