@@ -75,7 +75,7 @@ void traceLine(World& w) {
   const Vec3 f = b.orientation * Vec3::UnitX();
   const Vec3 l = b.orientation * Vec3::UnitY();
   const double deg = 180 / M_PI;
-  std::printf("  t %6.2f s  x %7.4f  y %7.4f  z %7.4f m  pitch %6.1f  roll %6.1f  yaw %6.1f deg  wheel load %5.2f N",
+  std::printf("  t %6.2f s  x %7.4f  y %7.4f  z %7.4f m  pitch %6.1f  roll %6.1f  yaw %6.1f deg  wheel load %7.4f N",
               w.time(), b.position.x(), b.position.y(), b.position.z(), -std::asin(f.z()) * deg, std::asin(l.z()) * deg,
               std::atan2(f.y(), f.x()) * deg, r.driveWheelLoad());
   if (r.description().findLink("gripper_tip")) std::printf("  gripper tip z %7.4f m", r.linkPose("gripper_tip").position.z());
@@ -511,9 +511,9 @@ Outcome steadySpeedTrial(const std::string& level, int units) {
   World w(c);
   Robot& r = spawn(w, d, {0, 0, 0});
   r.setSpeed(units, units);
-  w.stepN(static_cast<int>(3.0 / c.step));
+  runFor(w, 3.0, [] { return false; });
   const Vec3 a = r.basePose().position;
-  w.stepN(static_cast<int>(3.0 / c.step));
+  runFor(w, 3.0, [] { return false; });
   const Vec3 b = r.basePose().position;
   Outcome o{"ok"};
   o.value = (b - a).head<2>().norm() / 3.0;
@@ -578,16 +578,30 @@ std::vector<Outcome> runParallel(int n, int processes, const std::function<Outco
   return out;
 }
 
-std::string modal(const std::vector<Outcome>& outcomes, int* count) {
+std::vector<std::string> modalLabels(const std::vector<Outcome>& outcomes) {
   std::map<std::string, int> counts;
-  std::string best;
+  std::vector<std::pair<std::string, int>> reached;  // label, the count it reached, in order
   int best_n = 0;
   for (const auto& o : outcomes) {
     const int c = ++counts[o.label];
-    if (c > best_n) { best_n = c; best = o.label; }
+    if (c >= best_n) {
+      best_n = c;
+      reached.emplace_back(o.label, c);
+    }
   }
-  if (count) *count = best_n;
-  return best;
+  std::vector<std::string> labels;
+  for (const auto& [label, c] : reached)
+    if (c == best_n && std::find(labels.begin(), labels.end(), label) == labels.end()) labels.push_back(label);
+  return labels;
+}
+
+std::string modal(const std::vector<Outcome>& outcomes, int* count) {
+  const std::vector<std::string> labels = modalLabels(outcomes);
+  if (count) {
+    *count = 0;
+    for (const auto& o : outcomes) *count += !labels.empty() && o.label == labels.front();
+  }
+  return labels.empty() ? std::string() : labels.front();
 }
 
 }  // namespace validation

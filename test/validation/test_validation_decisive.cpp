@@ -76,3 +76,21 @@ TEST(ValidationFacts, DetailedTipsOverItsFrontNearTheStaticLimit) {
   EXPECT_GT(r[1].value2, 38.0) << "front uphill: slides near atan(mu)";
   EXPECT_LT(r[1].value2, r[1].value) << "front uphill: slides before it tips";
 }
+
+TEST(ValidationModal, ATieListsEveryLabelInTheOrderItReachedTheCount) {
+  // The report prints a tie as one and tallies it as a match only if the seed accepts every tied
+  // label (sbot_validate's modalCell): which label reaches the count first is only trial order.
+  auto outcomes = [](std::vector<std::string> labels) {
+    std::vector<v::Outcome> o;
+    for (auto& l : labels) o.push_back(v::Outcome{l});
+    return o;
+  };
+  const auto tie = outcomes({"slide back", "topple", "topple", "slide back", "stuck"});
+  EXPECT_EQ(v::modalLabels(tie), (std::vector<std::string>{"topple", "slide back"}));
+  int count = 0;
+  EXPECT_EQ(v::modal(tie, &count), "topple");
+  EXPECT_EQ(count, 2);
+  const auto clear = outcomes({"stuck", "topple", "topple", "pass"});
+  EXPECT_EQ(v::modalLabels(clear), (std::vector<std::string>{"topple"}));
+  EXPECT_TRUE(v::modalLabels({}).empty());
+}
