@@ -707,6 +707,13 @@ void Robot::applyBodyDrive(const TrackCommand& cmd) {
     f_max = std::min(traction, f_left + f_right);
     t_max = 0.5 * track_width_ * std::min(traction, std::min(f_left, f_right) * 2);
   }
+  // The motors hold the tracks' speed relative to the chassis: while the chassis pitches about the
+  // axle at rate w (> 0 nose down), a track on the ground moves it r w faster (a nose dropping into
+  // a gap drives the robot on under it, as with a wheel drive; a tail dropping holds it back).
+  if (driven_wheel_contacts_ > 0) {
+    const Quat q = bodyPose(baseBody()).orientation;
+    v += tr.wheel_radius * (q.inverse() * vec(dBodyGetAngularVel(baseBody()))).y();
+  }
   dJointSetLMotorParam(drive_linear_, dParamVel, v);
   dJointSetLMotorParam(drive_linear_, dParamFMax, f_max);
   dJointSetLMotorParam(drive_linear_, dParamVel2, 0);  // no side slip below the traction limit
