@@ -578,29 +578,21 @@ std::vector<Outcome> runParallel(int n, int processes, const std::function<Outco
   return out;
 }
 
-std::vector<std::string> modalLabels(const std::vector<Outcome>& outcomes) {
+std::vector<std::string> modalLabels(const std::vector<Outcome>& outcomes, int* count) {
   std::map<std::string, int> counts;
-  std::vector<std::pair<std::string, int>> reached;  // label, the count it reached, in order
   int best_n = 0;
-  for (const auto& o : outcomes) {
-    const int c = ++counts[o.label];
-    if (c >= best_n) {
-      best_n = c;
-      reached.emplace_back(o.label, c);
-    }
-  }
+  for (const auto& o : outcomes) best_n = std::max(best_n, ++counts[o.label]);
+  // A second pass in input order: a label joins when its running count reaches the modal count.
+  std::map<std::string, int> running;
   std::vector<std::string> labels;
-  for (const auto& [label, c] : reached)
-    if (c == best_n && std::find(labels.begin(), labels.end(), label) == labels.end()) labels.push_back(label);
+  for (const auto& o : outcomes)
+    if (++running[o.label] == best_n) labels.push_back(o.label);
+  if (count) *count = best_n;
   return labels;
 }
 
 std::string modal(const std::vector<Outcome>& outcomes, int* count) {
-  const std::vector<std::string> labels = modalLabels(outcomes);
-  if (count) {
-    *count = 0;
-    for (const auto& o : outcomes) *count += !labels.empty() && o.label == labels.front();
-  }
+  const std::vector<std::string> labels = modalLabels(outcomes, count);
   return labels.empty() ? std::string() : labels.front();
 }
 

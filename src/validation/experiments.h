@@ -116,8 +116,9 @@ std::vector<Outcome> runParallel(int n, int processes, const std::function<Outco
 
 /// The modal label of a set of outcomes (ties: the first label reaching the count, in input order).
 std::string modal(const std::vector<Outcome>& outcomes, int* count = nullptr);
-/// Every label with the modal count, in the order they reached it (more than one: a tie).
-std::vector<std::string> modalLabels(const std::vector<Outcome>& outcomes);
+/// Every label with the modal count (stored in `count`), in the order they reached it (more than
+/// one: a tie).
+std::vector<std::string> modalLabels(const std::vector<Outcome>& outcomes, int* count = nullptr);
 
 }  // namespace validation
 }  // namespace sbot

@@ -691,7 +691,8 @@ void Robot::applyBodyDrive(const TrackCommand& cmd) {
   // pushing from the side adds none. The wheels are passive supports (frictionless, like casters:
   // friction at the wheel contacts would tip the light robot over in every turn); the drive's grip
   // is the track material's.
-  const Vec3 up = bodyPose(baseBody()).orientation * Vec3::UnitZ();
+  const Quat q = bodyPose(baseBody()).orientation;
+  const Vec3 up = q * Vec3::UnitZ();
   const double traction =
       world_.config().contact.muFor("track", "ground") * std::max(0.0, driveContactForce().dot(up));
   drive_traction_ = traction;
@@ -710,20 +711,17 @@ void Robot::applyBodyDrive(const TrackCommand& cmd) {
   // The motors hold the tracks' speed relative to the chassis: while the chassis pitches about the
   // axle at rate w (> 0 nose down), a track on the ground moves it r w faster (a nose dropping into
   // a gap drives the robot on under it, as with a wheel drive; a tail dropping holds it back).
-  if (driven_wheel_contacts_ > 0) {
-    const Quat q = bodyPose(baseBody()).orientation;
-    v += tr.wheel_radius * (q.inverse() * vec(dBodyGetAngularVel(baseBody()))).y();
-  }
+  if (driven_wheel_contacts_ > 0) v += tr.wheel_radius * (q.inverse() * vec(dBodyGetAngularVel(baseBody()))).y();
   dJointSetLMotorParam(drive_linear_, dParamVel, v);
   dJointSetLMotorParam(drive_linear_, dParamFMax, f_max);
   dJointSetLMotorParam(drive_linear_, dParamVel2, 0);  // no side slip below the traction limit
   dJointSetLMotorParam(drive_linear_, dParamFMax2, traction);
   dJointSetAMotorParam(drive_angular_, dParamVel, yaw_rate);
   dJointSetAMotorParam(drive_angular_, dParamFMax, t_max);
-  applyDriveReaction();
+  applyDriveReaction(q);
 }
 
-void Robot::applyDriveReaction() {
+void Robot::applyDriveReaction(const Quat& q) {
   // A wheel motor that pushes the robot forward with force F turns the chassis the other way with
   // F times the wheel radius: nose up when driving or pushing forward, nose down when braking. The
   // body drive's force acts at the chassis' centre, on the axle, so this torque is added here, from
@@ -732,7 +730,6 @@ void Robot::applyDriveReaction() {
   // caster, which lifts the wheels, and it drops back instead of flipping over). Without it the
   // Fast robot pitched nose-down into every halved gap from 4.5 cm (Table 4.5).
   if (driven_wheel_contacts_ == 0) return;
-  const Quat q = bodyPose(baseBody()).orientation;
   const double push = (q.inverse() * vec(drive_linear_fb_.f1)).x();  // [N] along the heading
   const Vec3 axle = q * Vec3::UnitY();
   const double torque = -push * description_->treels.wheel_radius;  // [N m] about +y: > 0 nose down

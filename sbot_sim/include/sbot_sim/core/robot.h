@@ -201,7 +201,7 @@ class Robot {
   void measureTrackWidth();
   void buildBodyDrive();
   void applyBodyDrive(const TrackCommand& cmd);
-  void applyDriveReaction();
+  void applyDriveReaction(const Quat& chassis_orientation);
   void applyRollingResistance(const TrackCommand& cmd);  ///< TrackCommand::resist_torque_*
   /// trackCreepSlip for this step, from the motor targets in `cmd` and the last step's wheel loads.
   void updateCreepSlip(const TrackCommand& cmd);
