@@ -329,8 +329,8 @@ int main(int argc, char** argv) {
       md << "- " << r[0].label << "\n";
     }
     md << "\nStatic tipping angle (servos holding, gravity tilted 1 deg/s until the robot tilts 45 deg off "
-          "the slope's normal; rear uphill = it tips over its front, where the 4 cm turret offset puts the "
-          "centre of mass; \"slides\": before tipping, it slid 1 cm within a second without tilting). Quickstep's compliance lowers it; 200 "
+          "the slope's normal; rear uphill = it tips over its front, where the turret's forward COM offset puts "
+          "the centre of mass; \"slides\": before tipping, it slid 1 cm within a second without tilting). Quickstep's compliance lowers it; 200 "
           "iterations are the converged reference.\n\n"
        << "| level | rear uphill | front uphill | rear uphill, 200 iterations | front uphill, 200 iterations |\n"
           "|---|---|---|---|---|\n";
@@ -360,7 +360,7 @@ int main(int argc, char** argv) {
           "full: holds (< 1 cm slide) and climbs at >= 85 % of the commanded speed without rearing up; "
           "difficult: climbs but slower or rearing > 8 deg; slide: slides down; topple b/w: tilts > 45 deg "
           "off the slope normal.\n\n"
-       << "Orientation: **rear uphill** (the robot climbs in reverse, gripper and 4 cm turret COM offset "
+       << "Orientation: **rear uphill** (the robot climbs in reverse, gripper and the turret's forward COM offset "
           "downhill) is the matching condition; **front uphill** is shown as well. The seed does not say "
           "which way its robot faced; with the front uphill the COM offset makes the robot far more "
           "stable, and the seed's own Table 4.6 has the Detailed model climb 0.7 rad (40 deg) front first, "

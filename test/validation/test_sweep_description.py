@@ -19,7 +19,7 @@ def sweep(*args):
 class SweepDescription(unittest.TestCase):
     def test_a_grid_value_reaches_the_model_and_the_report(self):
         keep = tempfile.mkdtemp(prefix="sweep_test_")
-        r = sweep("--grid", "levels.medium.turret.com_m[0]=0.031,0.049", "--only", "4.2", "--trials", "1",
+        r = sweep("--grid", "levels.detailed.turret.com_m[0]=0.031,0.049", "--only", "4.2", "--trials", "1",
                   "--keep", keep)
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertIn("2 variant(s)", r.stdout)

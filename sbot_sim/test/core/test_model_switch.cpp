@@ -95,7 +95,8 @@ TEST(ModelSwitch, SwitchingToTheSameLevelDoesNotDisturbTheTrajectory) {
 TEST(ModelSwitch, SwitchedRunFollowsTheUnswitchedTrajectory) {
   // Through every full-size level: straight ahead the levels agree within 2 cm after 0.8 m; on a
   // curve their turning differs (seed 4.3: "the detailed model is not very accurate in making
-  // right angle turns"), still within 10 cm.
+  // right angle turns"), still within 12 cm (9.0 cm measured before the Detailed turret's COM was
+  // calibrated 1 cm further back than Medium's on the hardware rows, 10.2 cm since).
   const std::vector<std::string> cycle{"medium", "detailed", "medium", "basic", "simple", "basic"};
   const auto ref = driveSwitching(50, 50, {});
   const auto sw = driveSwitching(50, 50, cycle);
@@ -110,7 +111,7 @@ TEST(ModelSwitch, SwitchedRunFollowsTheUnswitchedTrajectory) {
   std::printf("curve, switched vs unswitched after 6 s: %.4f m, heading %.2f deg\n", err_c,
               test::wrapAngle(sw_c.first.yaw() - ref_c.first.yaw()) * 180 / M_PI);
   EXPECT_LT(sw_c.second, 0.003);
-  EXPECT_LT(err_c, 0.10);
+  EXPECT_LT(err_c, 0.12);
 }
 
 TEST(ModelSwitch, LevelsRoundTrip) {
@@ -130,8 +131,13 @@ TEST(ModelSwitch, LevelsRoundTrip) {
   EXPECT_EQ(r.bodies().size(), bodies);
   EXPECT_EQ(r.geomCount(), geoms);
   // Standing still through six switches: it has not moved.
+  std::printf("round trip: moved %.4f m, turned %.2f deg (yaw %.2f deg)\n", (r.basePose().position - p0.position).norm(),
+              r.basePose().orientation.angularDistance(p0.orientation) * 180 / M_PI,
+              test::wrapAngle(r.basePose().yaw() - p0.yaw()) * 180 / M_PI);
   EXPECT_LT((r.basePose().position - p0.position).norm(), 0.005);
-  EXPECT_LT(r.basePose().orientation.angularDistance(p0.orientation), 0.03);
+  // Turned: quickstep's yaw drift while standing (README, "Yaw drift and the turret weld"): 2.1 s
+  // standing gave 1.4 deg, 1.8 deg since the Detailed turret's COM calibration.
+  EXPECT_LT(r.basePose().orientation.angularDistance(p0.orientation), 0.045);
 }
 
 TEST(ModelSwitch, WideTurretAngleSurvives) {
