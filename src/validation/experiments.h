@@ -114,6 +114,12 @@ Outcome tippingAngle(const std::string& level, bool backward, int iterations = 0
 /// that crashes or throws yields label "error".
 std::vector<Outcome> runParallel(int n, int processes, const std::function<Outcome(int)>& fn);
 
+/// Whether a cell whose seed (or hardware) value is `expected` accepts our label `ours`. `expected`
+/// may list alternatives separated by '|' (mixed seed cells such as "pass (50%) stuck (50%)"); a
+/// seed "stuck" accepts our "fall inside" (fell in the gap), a "fail" our "topple" (toppling off a
+/// step fails it).
+bool accepts(const std::string& expected, const std::string& ours);
+
 /// The modal label of a set of outcomes (ties: the first label reaching the count, in input order).
 std::string modal(const std::vector<Outcome>& outcomes, int* count = nullptr);
 /// Every label with the modal count (stored in `count`), in the order they reached it (more than
