@@ -431,6 +431,7 @@ def build(level, p):
         "backdrive_force": tr["friction_force_N"],
         "torque_window": tr["torque_window_s"],
         "creep_stiffness": tr.get("creep_stiffness", 0.0),
+        "friction_scale": tr.get("friction_scale", 1.0),
         "drive": tr.get("drive", "wheels"),
     }
     sc["turret"] = {"joint": "turret_joint", "speed": api["speed_rads"], "unit": api["unit_rad"],

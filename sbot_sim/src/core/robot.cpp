@@ -694,7 +694,7 @@ void Robot::applyBodyDrive(const TrackCommand& cmd) {
   const Quat q = bodyPose(baseBody()).orientation;
   const Vec3 up = q * Vec3::UnitZ();
   const double traction =
-      world_.config().contact.muFor("track", "ground") * std::max(0.0, driveContactForce().dot(up));
+      world_.config().contact.muFor("track", "ground") * tr.friction_scale * std::max(0.0, driveContactForce().dot(up));
   drive_traction_ = traction;
   double v = 0, yaw_rate = 0, f_max = 0, t_max = 0;
   if (passive_) {

@@ -205,6 +205,7 @@ void parseSidecar(RobotDescription& d) {
   tr.backdrive_force = get<double>(t, "backdrive_force", tr.backdrive_force, file, "treels.");
   tr.torque_window = get<double>(t, "torque_window", tr.torque_window, file, "treels.");
   tr.creep_stiffness = get<double>(t, "creep_stiffness", tr.creep_stiffness, file, "treels.");
+  tr.friction_scale = get<double>(t, "friction_scale", tr.friction_scale, file, "treels.");
   // Every number below divides, scales or limits a motor: NaN, 0 or a sign error would silently
   // give a robot that cannot drive or one that explodes.
   const auto nonNegative = [&](double v, const std::string& field) {
@@ -222,6 +223,7 @@ void parseSidecar(RobotDescription& d) {
   nonNegative(tr.backdrive_force, "treels.backdrive_force");
   nonNegative(tr.torque_window, "treels.torque_window");
   nonNegative(tr.creep_stiffness, "treels.creep_stiffness");
+  requirePositive(tr.friction_scale, file, "treels.friction_scale");
   tr.drive = get<std::string>(t, "drive", tr.drive, file, "treels.");
   if (tr.drive != "wheels" && tr.drive != "body")
     throw ConfigError(file, "treels.drive", "expected 'wheels' or 'body', found '" + tr.drive + "'");

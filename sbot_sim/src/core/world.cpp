@@ -61,6 +61,18 @@ void applyTrackCreep(const GeomInfo& wheel, const Vec3& axle, const ContactConte
 
 const std::string kGround = "ground";
 
+/// The level's treels friction (TreelsSemantics::friction_scale) for a contact of a driven wheel;
+/// two driven wheels in contact (robots driving over each other) take the smaller; 1 otherwise.
+double treelsFrictionScale(const GeomInfo* a, const GeomInfo* b) {
+  const auto scale = [](const GeomInfo* g) {
+    return g && g->track >= 0 && g->robot ? g->robot->description().treels.friction_scale : -1.0;
+  };
+  const double sa = scale(a), sb = scale(b);
+  if (sa < 0 && sb < 0) return 1.0;
+  if (sa < 0 || sb < 0) return std::max(sa, sb);
+  return std::min(sa, sb);
+}
+
 }  // namespace
 
 double ContactConfig::muFor(const std::string& a, const std::string& b) const {
@@ -311,7 +323,7 @@ void World::handlePair(dGeomID a, dGeomID b) {
   dSurfaceParameters surface{};
   surface.mode = dContactSoftERP | dContactSoftCFM | (cc.coulomb ? dContactApprox1 : 0) |
                  (cc.bounce > 0 ? dContactBounce : 0);
-  surface.mu = cc.muFor(ctx.material_a, ctx.material_b);
+  surface.mu = cc.muFor(ctx.material_a, ctx.material_b) * treelsFrictionScale(ia, ib);
   surface.soft_erp = cc.erp;
   surface.soft_cfm = cc.cfm;
   surface.bounce = cc.bounce;

@@ -102,6 +102,7 @@ TEST(RobotDescription, MotorNumbersMustBeFiniteAndPositive) {
       {"  gear_ratio: 150", "treels.gear_ratio"},
       {"  wheel_radius: 0.022", "treels.wheel_radius"},
       {"recommended_step: 0.01", "recommended_step"},
+      {"  friction_scale: 2", "treels.friction_scale"},
   };
   for (const auto& [line, field] : cases) {
     for (const std::string bad : {".nan", "0", "-1"}) {

@@ -103,7 +103,8 @@ TEST(Treels, DrivingIntoAWallStopsTheRobotAndSlipsTheTracks) {
     r.getTrackTorque(&tl, &tr);
     mean_torque += 0.5 * (tl + tr) / 100.0;
   }
-  const double traction_limit_units = 1.0 * 0.66 * 9.81 / 2 * 0.022 / 0.0024412;  // mu m g / 2 * r
+  const double mu = w.config().contact.muFor("track", "ground") * r.description().treels.friction_scale;
+  const double traction_limit_units = mu * 0.66 * 9.81 / 2 * 0.022 / 0.0024412;  // mu m g / 2 * r
   EXPECT_LT(mean_torque, 0.5 * 90);
   EXPECT_LT(mean_torque, 1.2 * traction_limit_units);
 }
@@ -607,6 +608,41 @@ TEST(TrackCreep, NotForTheBodyDrive) {
   EXPECT_GT(r.driveWheelLoad(), 0);
   EXPECT_EQ(r.trackCreepSlip(0), 0.0);
   EXPECT_EQ(r.trackCreepSlip(1), 0.0);
+}
+
+// ---- Treels friction of a level (treels.friction_scale) -------------------------------------------
+
+TEST(TreelsFriction, TheLevelsScaleMultipliesTheTrackMaterialsMu) {
+  // A Detailed s-bot holding (setSpeed(0, 0)) front uphill on 35 deg (tilted gravity) on a surface
+  // where the track material's mu is 0.5 < tan 35 deg = 0.70: it slides; with the level's friction
+  // scale at 2 (mu 1.0) it stands. Nothing else differs.
+  double slid[2];
+  for (int doubled : {0, 1}) {
+    RobotDescription d = loadLevel("detailed");
+    ASSERT_EQ(d.treels.friction_scale, 1.0) << "Detailed is the reference level";
+    if (doubled) d.treels.friction_scale = 2.0;
+    WorldConfig c = flatWorld();
+    c.contact.material_mu["track"] = 0.5;
+    World w(c);
+    const double a = 35 * M_PI / 180;
+    dWorldSetGravity(w.odeWorld(), -c.gravity * std::sin(a), 0, -c.gravity * std::cos(a));
+    Robot& r = w.addRobot(d, {0, 0, 0}, "sbot_0");
+    r.setSpeed(0, 0);
+    runFor(w, 0.5);
+    const double x0 = r.basePose().position.x();
+    runFor(w, 2.0);
+    slid[doubled] = x0 - r.basePose().position.x();
+  }
+  EXPECT_GT(slid[0], 0.05) << "mu 0.5 on 35 deg";
+  EXPECT_LT(slid[1], 0.005) << "mu 0.5 x 2 on 35 deg";
+}
+
+TEST(TreelsFriction, OnlySimpleCalibratesItsOwn) {
+  // The calibration is documented in sbot_parameters.yaml (simple.treels.friction_scale): Basic,
+  // which must stand in for Medium and Detailed on the fly, and Fast keep the reference.
+  for (const std::string level : {"fast", "basic", "medium", "detailed"})
+    EXPECT_EQ(loadLevel(level).treels.friction_scale, 1.0) << level;
+  EXPECT_EQ(loadLevel("simple").treels.friction_scale, 2.0);
 }
 
 }  // namespace

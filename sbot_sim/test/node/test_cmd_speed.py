@@ -70,7 +70,10 @@ class TestCmdSpeed(unittest.TestCase):
         self.assertAlmostEqual(v.x, 50 * SPEED_UNIT, delta=0.1 * 50 * SPEED_UNIT,
                                msg='forward speed in base_link: %r' % v)
         self.assertLess(abs(v.y), 0.01, 'sideways speed in base_link: %r' % v)
-        self.assertLess(abs(odom.twist.twist.angular.z), 0.05)
+        # Not turning: the mean yaw rate over the last 0.5 s (50 messages). One message's rate is
+        # quickstep's contact jitter (Simple driving straight: rms 0.03 rad/s, peaks 0.1-0.3 rad/s).
+        rates = [self.odom['sbot_1'].wait_stamp(t - k * STEP).twist.twist.angular.z for k in range(50)]
+        self.assertLess(abs(sum(rates) / len(rates)), 0.02, 'mean yaw rate over 0.5 s: %r' % rates)
 
     def test_out_of_range_speed_is_limited_to_70_units(self):
         publish_and_settle(self.cmd_speed['sbot_1'], TrackSpeed(left=127, right=-300))

@@ -60,6 +60,9 @@ struct TreelsSemantics {
   /// own speed, F/N its traction ratio (World applies it to the driven wheels' terrain contacts).
   /// Dimensionless; 0 = no creep. Wheel drives only.
   double creep_stiffness = 0;
+  /// Friction of this level's treels abstraction relative to the track material: a driven wheel's
+  /// contacts (and Fast's body drive) use mu("track", surface) times this. Dimensionless, > 0.
+  double friction_scale = 1.0;
   /// "wheels": a velocity motor on every driven hinge (wheel-ground contacts carry the robot);
   /// "body": the tracks drive the chassis directly as an ideal differential drive (Robot, Fast).
   std::string drive = "wheels";
