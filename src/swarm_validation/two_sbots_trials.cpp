@@ -30,6 +30,7 @@ double tiltOf(const Robot& r) {
 SlopeResult pairSlope(const std::string& level, double angle, int trial, const SlopeSetup& setup) {
   WorldConfig c;
   c.seed = 7000 + trial;
+  validation::applyStudyKnobs(c);  // the solver study knobs, as sbot_validate (before the surface)
   if (setup.seed_friction) {
     constexpr double kSeedFrictionN = 1.2;  // 4.1.1 / Table 2.13: 12e4 dyne
     c.contact.coulomb = false;
@@ -40,7 +41,6 @@ SlopeResult pairSlope(const std::string& level, double angle, int trial, const S
   } else {
     validation::onPolystyrene(c);
   }
-  validation::applyStudyKnobs(c);  // the solver study knobs, as sbot_validate
   World w(c);
   const double g = c.gravity;
   dWorldSetGravity(w.odeWorld(), -g * std::sin(angle), 0, -g * std::cos(angle));

@@ -164,6 +164,19 @@ void applyStudyKnobs(WorldConfig& c) {
       throw ConfigError("$SBOT_VALIDATE_SOLVER", "", "expected 'quickstep' or 'exact', found '" + c.solver + "'");
   }
   if (std::getenv("SBOT_VALIDATE_WELD")) c.lock_idle_turret = true;
+  // A number from the environment, or a ConfigError naming the variable.
+  const auto number = [](const char* name, const char* text, double lo, double hi, const char* range) {
+    char* end = nullptr;
+    const double v = std::strtod(text, &end);
+    if (end == text || *end != '\0' || !(v >= lo && v <= hi))
+      throw ConfigError(std::string("$") + name, "", std::string("expected a number in ") + range + ", found '" + text + "'");
+    return v;
+  };
+  // Friction study: the track material's mu on the floor, steps, gaps and ramps (Table 4.1's
+  // polystyrene keeps kPolystyreneTrackMu); each level's treels.friction_scale still multiplies it.
+  if (const char* e = std::getenv("SBOT_VALIDATE_TRACK_MU"))
+    c.contact.material_mu["track"] = number("SBOT_VALIDATE_TRACK_MU", e, 0.0, 100.0, "[0, 100]");
+  if (const char* e = std::getenv("SBOT_VALIDATE_SOR")) c.solver_sor = number("SBOT_VALIDATE_SOR", e, 0.1, 1.99, "[0.1, 1.99]");
 }
 
 bool studyKnobsOk(const char* tool) {

@@ -60,7 +60,7 @@ TEST(ToolsCli, AnOptionWithoutItsValueIsRefusedByName) {
   expectRefused("two_sbots", "--level", "two_sbots: --level needs a value");
 }
 
-// The solver study knobs (src/validation/README.md "Solver") are read from the environment by both
+// The solver and friction study knobs (src/validation/README.md "Solver") are read from the environment by both
 // tools; a value they cannot use stops them before any trial (an unparsable iteration count used to
 // become 0 iterations through atoi).
 TEST(ToolsCli, UnusableStudyKnobsAreRefusedByName) {
@@ -74,7 +74,18 @@ TEST(ToolsCli, UnusableStudyKnobsAreRefusedByName) {
     EXPECT_EQ(o.status, 2) << o.output;
     EXPECT_NE(o.output.find("$SBOT_VALIDATE_SOLVER: expected 'quickstep' or 'exact', found 'fast'"), std::string::npos)
         << o.output;
+    o = sbot_test::runProcess("env SBOT_VALIDATE_SOR=2.5 " + bin + " --trial step detailed 0.010");
+    EXPECT_EQ(o.status, 2) << o.output;
+    EXPECT_NE(o.output.find("$SBOT_VALIDATE_SOR: expected a number in [0.1, 1.99], found '2.5'"), std::string::npos) << o.output;
+    o = sbot_test::runProcess("env SBOT_VALIDATE_TRACK_MU=nan " + bin + " --trial step detailed 0.010");
+    EXPECT_EQ(o.status, 2) << o.output;
+    EXPECT_NE(o.output.find("$SBOT_VALIDATE_TRACK_MU: expected a number in [0, 100], found 'nan'"), std::string::npos) << o.output;
   }
+  // The friction knob is taken: on frictionless treels the 10 mm step that passes is not climbed.
+  const Outcome slick = sbot_test::runProcess("env SBOT_VALIDATE_TRACK_MU=0 " + std::string(SWARMBOT3D_BIN_DIR) +
+                                              "/sbot_validate --trial step detailed 0.010");
+  EXPECT_EQ(slick.status, 0) << slick.output;
+  EXPECT_NE(slick.output.find("step detailed 0.01: fail"), std::string::npos) << slick.output;
   // A usable value is taken: one trial at 60 iterations.
   const Outcome o = sbot_test::runProcess("env SBOT_VALIDATE_ITERATIONS=60 " + std::string(SWARMBOT3D_BIN_DIR) +
                                           "/sbot_validate --trial step detailed 0.010");
