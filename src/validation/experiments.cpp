@@ -390,8 +390,19 @@ Outcome downhillTrial(const std::string& level, double angle_rad, int trial) {
   r.setSpeed(kSlowUnits, kSlowUnits);
   Outcome o{"stuck"};
   const double goal = L * std::cos(angle_rad) + 0.10 * s;
+  const Vec3 ramp_normal(std::sin(angle_rad), 0, std::cos(angle_rad));  // the ramp falls toward +x
+  const double foot = L * std::cos(angle_rad);
   runFor(w, (0.10 * s + L + 0.1 * s) / kSlowSpeed * 1.3 + 4.0, [&] {
-    if (angleBetween(upOf(r), Vec3::UnitZ()) > 100 * M_PI / 180) { o.label = "topple"; return true; }
+    // Toppled forward: over, or tilted more than 45 deg off the normal of the surface under its
+    // base (plateau, ramp, floor), i.e. pitched onto its nose or gripper (Table 4.3's rule). Until
+    // 2026-11-26 only "over" (100 deg) counted, and a Detailed robot that pitched 84 deg onto its
+    // gripper at 0.5 rad, slid down on it and fell back was a "pass".
+    const double x = r.basePose().position.x();
+    const Vec3 normal = x > 0 && x < foot ? ramp_normal : Vec3(Vec3::UnitZ());
+    if (angleBetween(upOf(r), Vec3::UnitZ()) > 100 * M_PI / 180 || angleBetween(upOf(r), normal) > 45 * M_PI / 180) {
+      o.label = "topple";
+      return true;
+    }
     if (r.basePose().position.x() > goal && angleBetween(upOf(r), Vec3::UnitZ()) < 0.3) { o.label = "pass"; return true; }
     return false;
   });

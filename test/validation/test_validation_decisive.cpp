@@ -109,3 +109,17 @@ TEST(ValidationFast, CrossesHalvedGapsItsFrontCasterDropsInto) {
   EXPECT_EQ(v::gapTrial("fast", 0.057, 0).label, "pass");
   EXPECT_EQ(v::gapTrial("fast", 0.065, 0).label, "stuck");
 }
+
+TEST(ValidationDownhill, DetailedManagesAGentleRampAndTopplesForwardOnSteeperOnes) {
+  // 4.2.4: all models manage downhill slopes up to about 0.5 rad; steeper ones topple them forward.
+  // The Detailed model tips over its front statically at ~26-28.5 deg (the test above): it manages
+  // 0.3 rad (17 deg) and topples at 0.8 rad (46 deg). At 0.5 rad (28.6 deg) it pitches 84 deg onto
+  // its held gripper and slides down on it, which the trial counts as the topple it is (tilted
+  // > 45 deg off the ramp's normal; before 2026-11-26 only > 100 deg off vertical counted, and this
+  // was a "pass").
+  const std::vector<double> angles{0.3, 0.5, 0.8};
+  const auto r = v::runParallel(3, 2, [&](int i) { return v::downhillTrial("detailed", angles[i], 0); });
+  EXPECT_EQ(r[0].label, "pass") << "0.3 rad";
+  EXPECT_EQ(r[1].label, "topple") << "0.5 rad";
+  EXPECT_EQ(r[2].label, "topple") << "0.8 rad";
+}
