@@ -77,6 +77,12 @@ TEST(ToolsCli, UnusableStudyKnobsAreRefusedByName) {
     o = sbot_test::runProcess("env SBOT_VALIDATE_SOR=2.5 " + bin + " --trial step detailed 0.010");
     EXPECT_EQ(o.status, 2) << o.output;
     EXPECT_NE(o.output.find("$SBOT_VALIDATE_SOR: expected a number in [0.1, 1.99], found '2.5'"), std::string::npos) << o.output;
+    o = sbot_test::runProcess("env SBOT_VALIDATE_CONTACT_CFM=-1 " + bin + " --trial step detailed 0.010");
+    EXPECT_EQ(o.status, 2) << o.output;
+    EXPECT_NE(o.output.find("$SBOT_VALIDATE_CONTACT_CFM: expected a number in [0, 1], found '-1'"), std::string::npos) << o.output;
+    o = sbot_test::runProcess("env SBOT_VALIDATE_CONTACT_ERP=x " + bin + " --trial step detailed 0.010");
+    EXPECT_EQ(o.status, 2) << o.output;
+    EXPECT_NE(o.output.find("$SBOT_VALIDATE_CONTACT_ERP: expected a number in [0.01, 1], found 'x'"), std::string::npos) << o.output;
     o = sbot_test::runProcess("env SBOT_VALIDATE_TRACK_MU=nan " + bin + " --trial step detailed 0.010");
     EXPECT_EQ(o.status, 2) << o.output;
     EXPECT_NE(o.output.find("$SBOT_VALIDATE_TRACK_MU: expected a number in [0, 100], found 'nan'"), std::string::npos) << o.output;
