@@ -392,9 +392,8 @@ Outcome downhillTrial(const std::string& level, double angle_rad, int trial) {
   w.stepN(static_cast<int>(0.3 / c.step));
   r.setSpeed(kSlowUnits, kSlowUnits);
   Outcome o{"stuck"};
-  const double goal = L * std::cos(angle_rad) + 0.10 * s;
+  const double foot = L * std::cos(angle_rad), goal = foot + 0.10 * s;
   const Vec3 ramp_normal(std::sin(angle_rad), 0, std::cos(angle_rad));  // the ramp falls toward +x
-  const double foot = L * std::cos(angle_rad);
   runFor(w, (0.10 * s + L + 0.1 * s) / kSlowSpeed * 1.3 + 4.0, [&] {
     // Toppled forward: over, or tilted more than 45 deg off the normal of the surface under its
     // base (plateau, ramp, floor), i.e. pitched onto its nose or gripper (Table 4.3's rule). Until
