@@ -64,28 +64,22 @@ TEST(ToolsCli, AnOptionWithoutItsValueIsRefusedByName) {
 // tools; a value they cannot use stops them before any trial (an unparsable iteration count used to
 // become 0 iterations through atoi).
 TEST(ToolsCli, UnusableStudyKnobsAreRefusedByName) {
+  // variable=value, and the message the tool must stop with (exit status 2)
+  const std::pair<std::string, std::string> refused[] = {
+      {"SBOT_VALIDATE_ITERATIONS=12x", "$SBOT_VALIDATE_ITERATIONS: expected a whole number in [1, 10000], found '12x'"},
+      {"SBOT_VALIDATE_SOLVER=fast", "$SBOT_VALIDATE_SOLVER: expected 'quickstep' or 'exact', found 'fast'"},
+      {"SBOT_VALIDATE_SOR=2.5", "$SBOT_VALIDATE_SOR: expected a number in [0.1, 1.99], found '2.5'"},
+      {"SBOT_VALIDATE_CONTACT_CFM=-1", "$SBOT_VALIDATE_CONTACT_CFM: expected a number in [0, 1], found '-1'"},
+      {"SBOT_VALIDATE_CONTACT_ERP=x", "$SBOT_VALIDATE_CONTACT_ERP: expected a number in [0.01, 1], found 'x'"},
+      {"SBOT_VALIDATE_TRACK_MU=nan", "$SBOT_VALIDATE_TRACK_MU: expected a number in [0, 100], found 'nan'"},
+  };
   for (const std::string tool : {"sbot_validate", "two_sbots"}) {
     const std::string bin = std::string(SWARMBOT3D_BIN_DIR) + "/" + tool;
-    Outcome o = sbot_test::runProcess("env SBOT_VALIDATE_ITERATIONS=12x " + bin + " --trial step detailed 0.010");
-    EXPECT_EQ(o.status, 2) << o.output;
-    EXPECT_NE(o.output.find(tool + ": $SBOT_VALIDATE_ITERATIONS: expected a whole number in [1, 10000], found '12x'"),
-              std::string::npos) << o.output;
-    o = sbot_test::runProcess("env SBOT_VALIDATE_SOLVER=fast " + bin + " --trial step detailed 0.010");
-    EXPECT_EQ(o.status, 2) << o.output;
-    EXPECT_NE(o.output.find("$SBOT_VALIDATE_SOLVER: expected 'quickstep' or 'exact', found 'fast'"), std::string::npos)
-        << o.output;
-    o = sbot_test::runProcess("env SBOT_VALIDATE_SOR=2.5 " + bin + " --trial step detailed 0.010");
-    EXPECT_EQ(o.status, 2) << o.output;
-    EXPECT_NE(o.output.find("$SBOT_VALIDATE_SOR: expected a number in [0.1, 1.99], found '2.5'"), std::string::npos) << o.output;
-    o = sbot_test::runProcess("env SBOT_VALIDATE_CONTACT_CFM=-1 " + bin + " --trial step detailed 0.010");
-    EXPECT_EQ(o.status, 2) << o.output;
-    EXPECT_NE(o.output.find("$SBOT_VALIDATE_CONTACT_CFM: expected a number in [0, 1], found '-1'"), std::string::npos) << o.output;
-    o = sbot_test::runProcess("env SBOT_VALIDATE_CONTACT_ERP=x " + bin + " --trial step detailed 0.010");
-    EXPECT_EQ(o.status, 2) << o.output;
-    EXPECT_NE(o.output.find("$SBOT_VALIDATE_CONTACT_ERP: expected a number in [0.01, 1], found 'x'"), std::string::npos) << o.output;
-    o = sbot_test::runProcess("env SBOT_VALIDATE_TRACK_MU=nan " + bin + " --trial step detailed 0.010");
-    EXPECT_EQ(o.status, 2) << o.output;
-    EXPECT_NE(o.output.find("$SBOT_VALIDATE_TRACK_MU: expected a number in [0, 100], found 'nan'"), std::string::npos) << o.output;
+    for (const auto& [setting, message] : refused) {
+      const Outcome o = sbot_test::runProcess("env " + setting + " " + bin + " --trial step detailed 0.010");
+      EXPECT_EQ(o.status, 2) << setting << ": " << o.output;
+      EXPECT_NE(o.output.find(tool + ": " + message), std::string::npos) << setting << ": " << o.output;
+    }
   }
   // The friction knob is taken: on frictionless treels the 10 mm step that passes is not climbed.
   const Outcome slick = sbot_test::runProcess("env SBOT_VALIDATE_TRACK_MU=0 " + std::string(SWARMBOT3D_BIN_DIR) +
