@@ -400,12 +400,14 @@ Outcome downhillTrial(const std::string& level, double angle_rad, int trial) {
     // 2026-11-26 only "over" (100 deg) counted, and a Detailed robot that pitched 84 deg onto its
     // gripper at 0.5 rad, slid down on it and fell back was a "pass".
     const double x = r.basePose().position.x();
+    const Vec3 up = upOf(r);
+    const double tilt = angleBetween(up, Vec3::UnitZ());
     const Vec3 normal = x > 0 && x < foot ? ramp_normal : Vec3(Vec3::UnitZ());
-    if (angleBetween(upOf(r), Vec3::UnitZ()) > 100 * M_PI / 180 || angleBetween(upOf(r), normal) > 45 * M_PI / 180) {
+    if (tilt > 100 * M_PI / 180 || angleBetween(up, normal) > 45 * M_PI / 180) {
       o.label = "topple";
       return true;
     }
-    if (r.basePose().position.x() > goal && angleBetween(upOf(r), Vec3::UnitZ()) < 0.3) { o.label = "pass"; return true; }
+    if (x > goal && tilt < 0.3) { o.label = "pass"; return true; }
     return false;
   });
   o.value = r.basePose().position.x();
