@@ -8,8 +8,9 @@
 // --quick: 3 trials per cell and 4 runs per roughness (minutes instead of tens of minutes).
 // Exit status: 0 when every hardware cell of Tables 4.1-4.3 matches, 1 otherwise, 2 on bad usage.
 //
-//   sbot_validate [--trace] --trial KIND LEVEL PARAM    one trial, printed (tuning aid); --trace
-//                                                        prints the robot's state every 0.1 s
+//   sbot_validate [--trace] [--index N] --trial KIND LEVEL PARAM    one trial, printed (tuning aid);
+//     --trace prints the robot's state every 0.1 s; --index N runs the cell's trial N (its start
+//     perturbation, as in the report; default 0)
 // KIND: gap, step, stepb, slope, slopeb, uphill, downhill, rough, rtm, speed (PARAM: m, m, m, deg,
 // deg, rad, rad, HR in cm, simulated s, setSpeed units of the compatibility check).
 #include <sys/stat.h>
@@ -213,6 +214,7 @@ int main(int argc, char** argv) {
   if (!v::studyKnobsOk("sbot_validate")) return 2;
   Options o;
   bool trace = false;
+  int index = 0;  // --index: which trial of a cell --trial runs (its start perturbation)
   sbot_tools::ArgReader args("sbot_validate", argc, argv);
   while (args.more()) {
     const std::string a = args.option();
@@ -223,20 +225,21 @@ int main(int argc, char** argv) {
     else if (a == "--heightmap") o.heightmap = args.value();
     else if (a == "--reasons") o.reasons = args.value();
     else if (a == "--trace") trace = true;  // with --trial (before it): the robot's state every 0.1 s
+    else if (a == "--index") index = args.count(0, 999);  // with --trial (before it): the cell's trial N
     else if (a == "--trial") {  // --trial KIND LEVEL PARAM: one trial, printed (tuning aid)
       const std::string kind = args.value(), level = args.value();
       const double p = sbot_tools::numberArg(args.tool(), "--trial " + kind + " " + level, args.value(), -1e6, 1e6);
       v::setTrace(trace);
       Outcome r;
       sbot_tools::requireLevel("sbot_validate", "--trial " + kind + " " + level, level);
-      if (kind == "gap") r = v::gapTrial(level, p, 0);
-      else if (kind == "step") r = v::stepTrial(level, p, false, 0);
-      else if (kind == "stepb") r = v::stepTrial(level, p, true, 0);
-      else if (kind == "slope") r = v::slopeHoldClimbTrial(level, p * M_PI / 180, false, 0);
-      else if (kind == "slopeb") r = v::slopeHoldClimbTrial(level, p * M_PI / 180, true, 0);
-      else if (kind == "uphill") r = v::uphillTrial(level, p, 0);
-      else if (kind == "downhill") r = v::downhillTrial(level, p, 0);
-      else if (kind == "rough") r = v::roughTrial(level, p, 0, findHeightmap());
+      if (kind == "gap") r = v::gapTrial(level, p, index);
+      else if (kind == "step") r = v::stepTrial(level, p, false, index);
+      else if (kind == "stepb") r = v::stepTrial(level, p, true, index);
+      else if (kind == "slope") r = v::slopeHoldClimbTrial(level, p * M_PI / 180, false, index);
+      else if (kind == "slopeb") r = v::slopeHoldClimbTrial(level, p * M_PI / 180, true, index);
+      else if (kind == "uphill") r = v::uphillTrial(level, p, index);
+      else if (kind == "downhill") r = v::downhillTrial(level, p, index);
+      else if (kind == "rough") r = v::roughTrial(level, p, index, findHeightmap());
       else if (kind == "rtm") r = v::rtmTrial(level, p);
       else if (kind == "speed") r = v::steadySpeedTrial(level, static_cast<int>(std::lround(p)));
       else {
@@ -252,7 +255,7 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr, "usage: sbot_validate --out DIR [--quick] [--trials N] [--jobs N] [--heightmap PNG] [--reasons YAML]\n"
                            "                     [--only facts,4.1,4.1pair,4.2,4.3,4.4,4.5,4.6,fig4.4,compat]\n"
-                           "       sbot_validate [--trace] --trial KIND LEVEL PARAM\n");
+                           "       sbot_validate [--trace] [--index N] --trial KIND LEVEL PARAM\n");
       return a == "--help" ? 0 : 2;
     }
   }
