@@ -28,6 +28,7 @@ TEST(ToolsCli, NonNumbersAndOutOfRangeValuesAreRefusedByName) {
   expectRefused("sbot_validate", "--out " + testing::TempDir() + "cli --trials abc", "--trials expects a number in [1, 1000], found 'abc'");
   expectRefused("sbot_validate", "--trial step detailed x", "--trial step detailed expects a number");
   expectRefused("sbot_validate", "--trial bogus detailed 1", "found 'bogus'");
+  expectRefused("sbot_validate", "--index -1 --trial gap fast 0.03", "--index expects a number in [0, 999], found '-1'");
   expectRefused("switching_experiment", "--runs 0", "--runs expects a number in [1, 1000], found '0'");
   expectRefused("switching_experiment", "--small-gap-max nan", "--small-gap-max expects a number");
   expectRefused("two_sbots", "--angles 10,x", "--angles expects a number in [0, 90], found 'x'");
@@ -91,6 +92,19 @@ TEST(ToolsCli, UnusableStudyKnobsAreRefusedByName) {
                                           "/sbot_validate --trial step detailed 0.010");
   EXPECT_EQ(o.status, 0) << o.output;
   EXPECT_NE(o.output.find("step detailed 0.01: pass"), std::string::npos) << o.output;
+}
+
+// --index picks the cell's trial, i.e. its start perturbation: trial 1 starts elsewhere than trial 0
+// (the printed end position differs), and naming trial 0 is the default.
+TEST(ToolsCli, IndexRunsAnotherTrialOfTheCell) {
+  const std::string tool = std::string(SWARMBOT3D_BIN_DIR) + "/sbot_validate ";
+  const Outcome first = sbot_test::runProcess(tool + "--trial gap fast 0.03");
+  const Outcome zero = sbot_test::runProcess(tool + "--index 0 --trial gap fast 0.03");
+  const Outcome second = sbot_test::runProcess(tool + "--index 1 --trial gap fast 0.03");
+  ASSERT_EQ(first.status, 0) << first.output;
+  ASSERT_EQ(second.status, 0) << second.output;
+  EXPECT_EQ(zero.output, first.output);
+  EXPECT_NE(second.output, first.output);
 }
 
 // Inputs that used to give a report anyway: a misspelt --only section (an empty report, status 0)
