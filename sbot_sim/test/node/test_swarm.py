@@ -119,8 +119,11 @@ class TestSwarm(unittest.TestCase):
         self.assertTrue(res.success, res.message)
         odom9 = Recorder('/sbot_9/ground_truth', Odometry).wait_connected()
         t = self.step(10)
-        g = self.latest_graph(t - 0.1)
-        self.assertIn('sbot_9', g.names)
+        # The graph stamped at the spawn's own time may predate it (the spawn is served after that
+        # step's publication), and the one at t may still be on its way: wait for the first graph
+        # with sbot_9 and check it came from these 10 steps.
+        g = self.graph.wait_for(lambda m: 'sbot_9' in m.names, timeout=10.0, what='listing sbot_9', first=True)
+        self.assertLessEqual(g.header.stamp.to_sec(), t + 1e-6)
         m = odom9.wait_for(lambda m: m.header.stamp.to_sec() >= t - 0.05)
         self.assertAlmostEqual(m.pose.pose.position.x, 1.0, delta=0.01)
         res = self.delete('sbot_0')  # the held robot: its connection goes with it
