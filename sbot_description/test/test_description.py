@@ -362,7 +362,10 @@ class TestDescription(unittest.TestCase):
             if simple.mass(l) > 0:
                 fi, si = fast.links[l].find("inertial/inertia"), simple.links[l].find("inertial/inertia")
                 self.assertTrue(close(float(fi.get("izz")), 0.05 * 0.25 * float(si.get("izz"))), l)
+        fast_override = TABLE["levels"]["fast"].get("override", {})
         for j in simple.joints:
+            if j.startswith("caster_") and "casters" in fast_override:
+                continue  # placed by Fast's own override (test_d_values_match_table checks them)
             fx, sx = fast.origin(j)[0], simple.origin(j)[0]
             for a, b in zip(fx, sx):
                 self.assertTrue(close(a, 0.5 * b, abs_=1e-9), "%s origin %r vs %r" % (j, fx, sx))
