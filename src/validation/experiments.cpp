@@ -65,8 +65,9 @@ int checkEvery(const World& w) { return std::max(1, static_cast<int>(std::lround
 bool g_trace = false;  // setTrace
 
 /// One line of the --trace output (every 0.1 s of simulated time): the first robot's base pose and
-/// attitude (pitch > 0 nose down, as REP-103), its driven wheels' load and the front gripper tip's
-/// height (what decides most of the tables' cells).
+/// attitude (pitch > 0 nose down, as REP-103), its driven wheels' load, its tracks' speeds (the
+/// encoders), the turret's angle and the front gripper tip's height (what decides most of the
+/// tables' cells).
 void traceLine(World& w) {
   const std::vector<Robot*> robots = w.robots();
   if (robots.empty()) return;
@@ -78,6 +79,7 @@ void traceLine(World& w) {
   std::printf("  t %6.2f s  x %7.4f  y %7.4f  z %7.4f m  pitch %6.1f  roll %6.1f  yaw %6.1f deg  wheel load %7.4f N",
               w.time(), b.position.x(), b.position.y(), b.position.z(), -std::asin(f.z()) * deg, std::asin(l.z()) * deg,
               std::atan2(f.y(), f.x()) * deg, r.driveWheelLoad());
+  std::printf("  tracks %6.3f %6.3f m/s  turret %5.1f deg", r.trackSpeedLeft(), r.trackSpeedRight(), r.turretAngle() * deg);
   if (r.description().findLink("gripper_tip")) std::printf("  gripper tip z %7.4f m", r.linkPose("gripper_tip").position.z());
   std::printf("\n");
 }

@@ -9,7 +9,8 @@
 // Exit status: 0 when every hardware cell of Tables 4.1-4.3 matches, 1 otherwise, 2 on bad usage.
 //
 //   sbot_validate [--trace] [--index N] --trial KIND LEVEL PARAM    one trial, printed (tuning aid);
-//     --trace prints the robot's state every 0.1 s; --index N runs the cell's trial N (its start
+//     --trace prints the robot's state every 0.1 s (pose, attitude, wheel load, track speeds,
+//     turret angle, gripper tip); --index N runs the cell's trial N (its start
 //     perturbation, as in the report; default 0)
 // KIND: gap, step, stepb, slope, slopeb, uphill, downhill, rough, rtm, speed (PARAM: m, m, m, deg,
 // deg, rad, rad, HR in cm, simulated s, setSpeed units of the compatibility check).

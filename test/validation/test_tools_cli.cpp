@@ -146,7 +146,8 @@ TEST(ToolsCli, AValidTrialRuns) {
   EXPECT_EQ(o.output.find("pitch"), std::string::npos) << "no trace unless asked";
 }
 
-// --trace prints the robot's state every 0.1 s: here the Detailed model reversing into a 15 mm step
+// --trace prints the robot's state every 0.1 s (pose, attitude, wheel load, track speeds, turret
+// angle, gripper tip height): here the Detailed model reversing into a 15 mm step
 // tips nose down toward its gripper (the hardware passes; 10 mm passes since the turret COM
 // calibration); the trial stops as a topple once it is 45 deg off the vertical
 // (it used to drive on standing on its gripper at 70-77 deg and count as a pass).
@@ -162,6 +163,13 @@ TEST(ToolsCli, TraceShowsTheRobotTippingOntoItsGripper) {
   }
   EXPECT_GT(lines, 20) << o.output;
   EXPECT_GT(max_pitch, 30.0) << o.output;
+  // The encoders show the tracks reversing (left track speed < 0 on some line), and the turret's
+  // angle is printed beside them.
+  double min_track = 0;
+  for (std::size_t at = o.output.find("tracks"); at != std::string::npos; at = o.output.find("tracks", at + 1))
+    min_track = std::min(min_track, std::atof(o.output.c_str() + at + 6));
+  EXPECT_LT(min_track, -0.02) << o.output;
+  EXPECT_NE(o.output.find("turret"), std::string::npos) << o.output;
   expectRefused("sbot_validate", "--out " + testing::TempDir() + "cli --trace", "--trace goes with --trial");
 }
 
