@@ -432,6 +432,8 @@ def build(level, p):
         "torque_window": tr["torque_window_s"],
         "creep_stiffness": tr.get("creep_stiffness", 0.0),
         "friction_scale": tr.get("friction_scale", 1.0),
+        "friction_law": tr.get("friction_law", "coulomb"),
+        "friction_force_limit": tr["friction_force_N"],
         "drive": tr.get("drive", "wheels"),
     }
     sc["turret"] = {"joint": "turret_joint", "speed": api["speed_rads"], "unit": api["unit_rad"],

@@ -10,6 +10,7 @@
 #include <limits>
 #include <mutex>
 #include <sstream>
+#include <stdexcept>
 
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/geom_info.h"
@@ -329,6 +330,11 @@ void World::handlePair(dGeomID a, dGeomID b) {
   surface.bounce = cc.bounce;
   surface.bounce_vel = 0.05;
   const Robot* mover = ctx.robot_a ? ctx.robot_a : ctx.robot_b;
+  if (mover && (!ba || !bb) && mover->description().treels.friction_law == "force_limit") {
+    // The seed's friction law for this level: each terrain contact holds up to a fixed force.
+    surface.mode &= ~dContactApprox1;
+    surface.mu = mover->description().treels.friction_force_limit;
+  }
   // With fdir1 set (a robot against static geometry) the mover is also the wheels' robot.
   const Quat orientation = mover ? mover->basePose().orientation : Quat::Identity();
   const Vec3 heading = mover ? Vec3(orientation * Vec3::UnitX()) : Vec3::Zero();
@@ -461,21 +467,7 @@ void boxCallback(void* data, dGeomID o1, dGeomID o2) {
 
 }  // namespace
 
-std::vector<RayHit> World::castRays(const Vec3& origin, const std::vector<Vec3>& directions, double length,
-                                    const Robot* ignore) const {
-  RayHit miss;
-  miss.distance = length;
-  std::vector<RayHit> hits(directions.size(), miss);
-  if (directions.empty()) return hits;
-  // One broad-phase search for the box around every ray's segment instead of one per ray: for a
-  // sensor's 5-ray cone that was most of the cost of a ray (ODE's space traversal), and a ray can
-  // only hit a geom whose bounding box meets its segment's, so the hits are castRay's.
-  Vec3 lo = origin, hi = origin;
-  for (const Vec3& d : directions) {
-    const Vec3 end = origin + d.normalized() * length;
-    lo = lo.cwiseMin(end);
-    hi = hi.cwiseMax(end);
-  }
+void World::findRayCandidates(const Vec3& lo, const Vec3& hi, const Robot* ignore) const {
   constexpr double kMargin = 1e-6;  // [m] keeps the box's sides from vanishing (axis-aligned rays)
   if (!query_box_) query_box_ = dCreateBox(nullptr, 1, 1, 1);
   const Vec3 centre = 0.5 * (lo + hi), size = (hi - lo).array() + 2 * kMargin;
@@ -485,6 +477,13 @@ std::vector<RayHit> World::castRays(const Vec3& origin, const std::vector<Vec3>&
   BoxQuery box{query_box_, ignore, &ray_candidates_};
   dSpaceCollide2(query_box_, reinterpret_cast<dGeomID>(space_), &box, &boxCallback);
   dSpaceCollide2(query_box_, reinterpret_cast<dGeomID>(static_space_), &box, &boxCallback);
+}
+
+std::vector<RayHit> World::castAgainstCandidates(const Vec3& origin, const std::vector<Vec3>& directions,
+                                                 double length, const Robot* ignore) const {
+  RayHit miss;
+  miss.distance = length;
+  std::vector<RayHit> hits(directions.size(), miss);
   if (ray_candidates_.empty()) return hits;
   dGeomID ray = queryRay(length);
   for (std::size_t i = 0; i < directions.size(); ++i) {
@@ -492,6 +491,41 @@ std::vector<RayHit> World::castRays(const Vec3& origin, const std::vector<Vec3>&
     dGeomRaySet(ray, origin.x(), origin.y(), origin.z(), d.x(), d.y(), d.z());
     RayQuery query{ignore, &hits[i]};
     for (dGeomID g : ray_candidates_) rayAgainstGeom(query, ray, g);
+  }
+  return hits;
+}
+
+std::vector<RayHit> World::castRays(const Vec3& origin, const std::vector<Vec3>& directions, double length,
+                                    const Robot* ignore) const {
+  return castRayBundles({origin}, {directions}, length, ignore).front();
+}
+
+std::vector<std::vector<RayHit>> World::castRayBundles(const std::vector<Vec3>& origins,
+                                                       const std::vector<std::vector<Vec3>>& directions,
+                                                       double length, const Robot* ignore) const {
+  if (origins.size() != directions.size())
+    throw std::invalid_argument("castRayBundles: one direction list per origin");
+  // One broad-phase search for the box around every ray's segment instead of one per ray (for a
+  // sensor's 5-ray cone that was most of the cost of a ray: ODE's space traversal) or per bundle
+  // (a 15-sensor ring); a ray can only hit a geom whose bounding box meets its segment's, so the
+  // hits are castRay's.
+  std::vector<std::vector<RayHit>> hits;
+  hits.reserve(origins.size());
+  bool any = false;
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();
+  for (std::size_t k = 0; k < origins.size(); ++k) {
+    for (const Vec3& d : directions[k]) {
+      const Vec3 end = origins[k] + d.normalized() * length;
+      if (!any) lo = hi = origins[k];
+      lo = lo.cwiseMin(origins[k]).cwiseMin(end);
+      hi = hi.cwiseMax(origins[k]).cwiseMax(end);
+      any = true;
+    }
+  }
+  if (any) findRayCandidates(lo, hi, ignore);
+  for (std::size_t k = 0; k < origins.size(); ++k) {
+    if (!any) ray_candidates_.clear();
+    hits.push_back(castAgainstCandidates(origins[k], directions[k], length, ignore));
   }
   return hits;
 }

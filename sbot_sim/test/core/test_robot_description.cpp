@@ -103,6 +103,7 @@ TEST(RobotDescription, MotorNumbersMustBeFiniteAndPositive) {
       {"  wheel_radius: 0.022", "treels.wheel_radius"},
       {"recommended_step: 0.01", "recommended_step"},
       {"  friction_scale: 2", "treels.friction_scale"},
+      {"  friction_force_limit: 1.2", "treels.friction_force_limit"},
   };
   for (const auto& [line, field] : cases) {
     for (const std::string bad : {".nan", "0", "-1"}) {
@@ -112,6 +113,11 @@ TEST(RobotDescription, MotorNumbersMustBeFiniteAndPositive) {
           << line << " -> " << bad << ": " << c.loadError();
     }
   }
+  BrokenCopy law;
+  law.breakSidecar("friction_law: coulomb", "friction_law: sticky");
+  EXPECT_NE(law.loadError().find("field 'treels.friction_law': expected 'coulomb' or 'force_limit', found 'sticky'"),
+            std::string::npos)
+      << law.loadError();
   BrokenCopy turret;
   turret.breakSidecar("max_torque: 1.4881352", "max_torque: .nan");
   EXPECT_NE(turret.loadError().find("field 'turret.max_torque'"), std::string::npos) << turret.loadError();

@@ -110,5 +110,38 @@ TEST(GroundSensors, NothingWithinSixCentimetresReadsZeroAndSkipsEffects) {
   EXPECT_THROW(g2.read(4), std::out_of_range);
 }
 
+// readAll casts the four bundles at once; its readings (noise included, drawn in the same order)
+// are those of read(0..3) in an identically seeded world, here half over a cliff.
+TEST(GroundSensors, ReadAllReadsWhatEachSensorReads) {
+  auto readings = [](bool all_at_once) {
+    WorldConfig c = flatWorld(5);
+    c.terrain.type = TerrainConfig::Type::Composite;
+    c.terrain.ground_plane = false;
+    BoxObstacle ledge;
+    ledge.name = "ledge";
+    ledge.center = Vec3(-0.5, 0, -0.05);
+    ledge.size = Vec3(1.0, 1.0, 0.1);  // top at z = 0 up to x = 0: the robot's front is over the edge
+    c.terrain.boxes.push_back(ledge);
+    World w(c);
+    Robot& r = w.addRobot(loadLevel("medium"), {-0.02, 0, 0}, "sbot_0");
+    GroundSensors g(w, r);
+    std::vector<unsigned> out;
+    for (int n = 0; n < 10; ++n) {
+      if (all_at_once) {
+        for (unsigned v : g.readAll()) out.push_back(v);
+      } else {
+        for (int i = 0; i < kGroundSensors; ++i) out.push_back(g.read(i));
+      }
+    }
+    return out;
+  };
+  const std::vector<unsigned> together = readings(true), one_by_one = readings(false);
+  EXPECT_EQ(together, one_by_one);
+  int seen = 0, cliff = 0;
+  for (unsigned v : together) (v > 0 ? seen : cliff) += 1;
+  EXPECT_GT(seen, 0) << "some sensors must see the ledge";
+  EXPECT_GT(cliff, 0) << "and some the cliff, for the comparison to mean anything";
+}
+
 }  // namespace
 }  // namespace sbot::test

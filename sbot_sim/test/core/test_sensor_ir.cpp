@@ -215,6 +215,35 @@ TEST(RayTracedIr, NoiseComesFromTheRobotsSeededStream) {
   EXPECT_NE(readSequence(3, "sbot_0"), readSequence(3, "sbot_1")) << "each robot has its own stream";
 }
 
+// readAll casts the whole ring at once; its readings (noise included, drawn in the same order)
+// are those of read(0..14) in an identically seeded world.
+TEST(RayTracedIr, ReadAllReadsWhatEachSensorReads) {
+  auto ring = [](bool all_at_once) {
+    WorldConfig c = flatWorld(9);
+    const Pose2D at{0, 0, 0.2};
+    c.terrain.boxes.push_back(wallFacing(spawnPose("medium", at, "ir_2"), 0.03));
+    c.terrain.boxes.push_back(wallFacing(spawnPose("medium", at, "ir_9"), 0.08));
+    World w(c);
+    Robot& r = spawnOnFloor(w, "medium", at, "sbot_0");
+    w.addRobot(loadLevel("simple"), {-0.16, 0.02, 0}, "sbot_1");
+    ProximitySensors ir(w, r, ProximitySensors::Model::RayTraced);
+    std::vector<unsigned> out;
+    for (int n = 0; n < 5; ++n) {
+      if (all_at_once) {
+        for (unsigned v : ir.readAll()) out.push_back(v);
+      } else {
+        for (int i = 0; i < kProximitySensors; ++i) out.push_back(ir.read(i));
+      }
+    }
+    return out;
+  };
+  const std::vector<unsigned> together = ring(true), one_by_one = ring(false);
+  EXPECT_EQ(together, one_by_one);
+  int seen = 0;
+  for (unsigned v : together) seen += v > 0;
+  EXPECT_GE(seen, 3 * 5) << "the walls and the neighbour must be seen for the comparison to mean anything";
+}
+
 // ---- look-up-table model (Simple) ------------------------------------------------------------------
 
 TEST(LutIr, SeesANeighbourLikeTheRayTracedModelButNoWalls) {

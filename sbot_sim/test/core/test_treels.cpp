@@ -637,6 +637,32 @@ TEST(TreelsFriction, TheLevelsScaleMultipliesTheTrackMaterialsMu) {
   EXPECT_LT(slid[1], 0.005) << "mu 0.5 x 2 on 35 deg";
 }
 
+TEST(TreelsFriction, ForceLimitLawHoldsEachContactToAFixedForce) {
+  // The seed's friction law (sidecar treels.friction_law: force_limit; no level uses it, see
+  // "Medium's friction law" in src/validation/README.md): each terrain contact holds up to
+  // friction_force_limit whatever its load. A Medium s-bot holding (setSpeed(0, 0)) on 30 deg
+  // needs 6.5 N x sin 30 = 3.2 N: its six spheres at 1.2 N each hold it, at 0.3 N each (1.8 N in
+  // all) it slides; Coulomb (mu 1 > tan 30) holds.
+  auto slid = [](const std::string& law, double limit) {
+    RobotDescription d = loadLevel("medium");
+    d.treels.friction_law = law;
+    d.treels.friction_force_limit = limit;
+    WorldConfig c = flatWorld();
+    World w(c);
+    const double a = 30 * M_PI / 180;
+    dWorldSetGravity(w.odeWorld(), -c.gravity * std::sin(a), 0, -c.gravity * std::cos(a));
+    Robot& r = w.addRobot(d, {0, 0, 0}, "sbot_0");
+    r.setSpeed(0, 0);
+    runFor(w, 0.5);
+    const double x0 = r.basePose().position.x();
+    runFor(w, 2.0);
+    return x0 - r.basePose().position.x();
+  };
+  EXPECT_LT(slid("coulomb", 0.3), 0.01) << "the limit is ignored under Coulomb";
+  EXPECT_LT(slid("force_limit", 1.2), 0.01);
+  EXPECT_GT(slid("force_limit", 0.3), 0.05);
+}
+
 TEST(TreelsFriction, OnlySimpleCalibratesItsOwn) {
   // The calibration is documented in sbot_parameters.yaml (simple.treels.friction_scale): Basic,
   // which must stand in for Medium and Detailed on the fly, and Fast keep the reference.

@@ -3,7 +3,9 @@
 // rough height field, with and without the sensing robot ignored.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include "sim_fixture.h"
@@ -60,6 +62,56 @@ TEST(WorldRays, BundleSeesWhatSingleRaysSeeAmongBoxesAndRobots) {
   expectSameHits(w, nullptr, rng, 400, &hits);
   expectSameHits(w, &a, rng, 400, &hits);
   EXPECT_GT(hits, 1000) << "the bundles must actually hit things for the comparison to mean anything";
+}
+
+// Several bundles searched at once (a sensor ring, castRayBundles) see what each bundle sees alone.
+TEST(WorldRays, RingOfBundlesSeesWhatEachBundleSees) {
+  WorldConfig c = flatWorld();
+  c.terrain.type = TerrainConfig::Type::Composite;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < 8; ++i) {
+    BoxObstacle box;
+    box.name = "box_" + std::to_string(i);
+    box.center = Vec3(0.3 * u(rng), 0.3 * u(rng), 0.05);
+    box.size = Vec3(0.05, 0.08, 0.1);
+    box.yaw = M_PI * u(rng);
+    c.terrain.boxes.push_back(box);
+  }
+  World w(c);
+  Robot& a = w.addRobot(loadLevel("medium"), {0, 0, 0}, "sbot_a");
+  w.addRobot(loadLevel("simple"), {0.15, 0.05, 1.0}, "sbot_b");
+  runFor(w, 0.2);
+  int hits = 0;
+  for (int ring = 0; ring < 50; ++ring) {
+    std::vector<Vec3> origins;
+    std::vector<std::vector<Vec3>> dirs;
+    for (int k = 0; k < 15; ++k) {  // a ring around the robot, each sensor a 5-ray cone outwards
+      const double bearing = 2 * M_PI * k / 15 + 0.1 * u(rng);
+      const Vec3 out(std::cos(bearing), std::sin(bearing), 0.1 * u(rng));
+      origins.push_back(Vec3(0, 0, 0.06) + 0.06 * Vec3(out.x(), out.y(), 0));
+      std::vector<Vec3> cone;
+      for (int i = 0; i < 5; ++i) cone.push_back((out + 0.2 * Vec3(u(rng), u(rng), u(rng))).normalized());
+      dirs.push_back(cone);
+    }
+    const double length = 0.05 + 0.25 * (u(rng) + 1);
+    const Robot* ignore = ring % 2 ? &a : nullptr;
+    const auto together = w.castRayBundles(origins, dirs, length, ignore);
+    ASSERT_EQ(together.size(), origins.size());
+    for (std::size_t k = 0; k < origins.size(); ++k) {
+      const std::vector<RayHit> alone = w.castRays(origins[k], dirs[k], length, ignore);
+      ASSERT_EQ(together[k].size(), alone.size());
+      for (std::size_t i = 0; i < alone.size(); ++i) {
+        ASSERT_EQ(together[k][i].hit, alone[i].hit) << "ring " << ring << " bundle " << k << " ray " << i;
+        EXPECT_DOUBLE_EQ(together[k][i].distance, alone[i].distance);
+        EXPECT_EQ(together[k][i].surface, alone[i].surface);
+        EXPECT_EQ(together[k][i].robot, alone[i].robot);
+        hits += alone[i].hit;
+      }
+    }
+  }
+  EXPECT_GT(hits, 500) << "the rings must actually hit things for the comparison to mean anything";
+  EXPECT_THROW(w.castRayBundles({Vec3::Zero()}, {}, 0.1, nullptr), std::invalid_argument);
 }
 
 TEST(WorldRays, BundleSeesWhatSingleRaysSeeOnRoughTerrain) {

@@ -90,6 +90,11 @@ class World {
   /// but the spaces are searched once, for the box that bounds the whole bundle.
   std::vector<RayHit> castRays(const Vec3& origin, const std::vector<Vec3>& directions, double length,
                                const Robot* ignore) const;
+  /// Several bundles (a sensor ring: bundle k = `directions[k]` from `origins[k]`) with one search of
+  /// the spaces, for the box around all of them: the same hits as castRays per bundle.
+  std::vector<std::vector<RayHit>> castRayBundles(const std::vector<Vec3>& origins,
+                                                  const std::vector<std::vector<Vec3>>& directions, double length,
+                                                  const Robot* ignore) const;
 
   void addEffect(EffectPtr effect) { effects_.push_back(std::move(effect)); }
   const std::vector<EffectPtr>& effects() const { return effects_; }
@@ -128,6 +133,11 @@ class World {
   bool exact_solver_ = false;     ///< config_.solver == "exact"
   void updateSolverIterations();  ///< after a robot came, went or changed level
   dGeomID queryRay(double length) const;  ///< query_ray_ with this length
+  /// Fills ray_candidates_ with the geoms (not `ignore`'s) whose bounding boxes meet [lo, hi].
+  void findRayCandidates(const Vec3& lo, const Vec3& hi, const Robot* ignore) const;
+  /// Casts the rays from `origin` against ray_candidates_ only; hits[i] for directions[i].
+  std::vector<RayHit> castAgainstCandidates(const Vec3& origin, const std::vector<Vec3>& directions, double length,
+                                            const Robot* ignore) const;
   dJointGroupID contacts_ = nullptr;
   /// This step's contacts on driven treels wheels, with ODE's force feedback (Robot::driveWheelLoad).
   /// A deque: ODE keeps pointers to the feedback records while the step runs.

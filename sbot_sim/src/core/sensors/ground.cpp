@@ -54,8 +54,11 @@ double GroundSensors::rawDistance(int sensor) const {
 
 unsigned GroundSensors::read(int sensor) {
   if (sensor < 0 || sensor >= kGroundSensors) throw std::out_of_range("ground sensor must be in [0,3]");
-  const BundleHit hit = traceBundle(world_, robot_.linkPose(links_[sensor]), directions_, model_.range_min,
-                                    model_.range_max, &robot_);
+  return finish(sensor, traceBundle(world_, robot_.linkPose(links_[sensor]), directions_, model_.range_min,
+                                    model_.range_max, &robot_));
+}
+
+unsigned GroundSensors::finish(int sensor, const BundleHit& hit) {
   if (hit.hits == 0) return 0;
   SensorSample s;
   s.channel = "ground";
@@ -70,8 +73,15 @@ unsigned GroundSensors::read(int sensor) {
 }
 
 std::array<unsigned, kGroundSensors> GroundSensors::readAll() {
+  // The four bundles with one search of the spaces (traceBundles); the readings, and the order of
+  // their noise draws, are those of read(0..3).
+  std::vector<Pose> poses;
+  poses.reserve(kGroundSensors);
+  for (const auto& link : links_) poses.push_back(robot_.linkPose(link));
+  const std::vector<BundleHit> hits =
+      traceBundles(world_, poses, directions_, model_.range_min, model_.range_max, &robot_);
   std::array<unsigned, kGroundSensors> out{};
-  for (int i = 0; i < kGroundSensors; ++i) out[i] = read(i);
+  for (int i = 0; i < kGroundSensors; ++i) out[i] = finish(i, hits[i]);
   return out;
 }
 

@@ -43,15 +43,21 @@ LogLogResponse proximityResponse(const IrRayModel& model) {
                         model.range_max, 8191.0);
 }
 
-BundleHit traceBundle(const World& world, const Pose& sensor, const std::vector<Vec3>& directions,
-                      double range_min, double range_max, const Robot* ignore) {
-  BundleHit out;
-  double sum = 0;
-  double nearest = kInf;
+namespace {
+
+/// The sensor's cone in world directions.
+std::vector<Vec3> worldDirections(const Pose& sensor, const std::vector<Vec3>& directions) {
   std::vector<Vec3> dirs;
   dirs.reserve(directions.size());
   for (const Vec3& local : directions) dirs.push_back(sensor.orientation * local);
-  const std::vector<RayHit> hits = world.castRays(sensor.position, dirs, range_max, ignore);
+  return dirs;
+}
+
+/// One bundle's hits summarised: how many, their mean distance, the nearest and its incidence.
+BundleHit summarise(const std::vector<Vec3>& dirs, const std::vector<RayHit>& hits, double range_min) {
+  BundleHit out;
+  double sum = 0;
+  double nearest = kInf;
   for (std::size_t i = 0; i < dirs.size(); ++i) {
     const Vec3& dir = dirs[i];
     const RayHit& h = hits[i];
@@ -66,6 +72,29 @@ BundleHit traceBundle(const World& world, const Pose& sensor, const std::vector<
     }
   }
   out.mean_distance = out.hits > 0 ? sum / out.hits : kInf;
+  return out;
+}
+
+}  // namespace
+
+BundleHit traceBundle(const World& world, const Pose& sensor, const std::vector<Vec3>& directions,
+                      double range_min, double range_max, const Robot* ignore) {
+  return traceBundles(world, {sensor}, directions, range_min, range_max, ignore).front();
+}
+
+std::vector<BundleHit> traceBundles(const World& world, const std::vector<Pose>& sensors,
+                                    const std::vector<Vec3>& directions, double range_min, double range_max,
+                                    const Robot* ignore) {
+  std::vector<Vec3> origins;
+  std::vector<std::vector<Vec3>> dirs;
+  for (const Pose& p : sensors) {
+    origins.push_back(p.position);
+    dirs.push_back(worldDirections(p, directions));
+  }
+  const std::vector<std::vector<RayHit>> hits = world.castRayBundles(origins, dirs, range_max, ignore);
+  std::vector<BundleHit> out;
+  out.reserve(sensors.size());
+  for (std::size_t k = 0; k < sensors.size(); ++k) out.push_back(summarise(dirs[k], hits[k], range_min));
   return out;
 }
 
@@ -292,8 +321,11 @@ ProximitySensors::ProximitySensors(World& world, Robot& robot, Model model, cons
 ProximitySensors::Raw ProximitySensors::raw(int sensor) const {
   if (sensor < 0 || sensor >= kProximitySensors) throw std::out_of_range("proximity sensor must be in [0,14]");
   if (model_ == Model::LookupTable) return rawLut(sensor);
-  const BundleHit hit = traceBundle(world_, robot_.linkPose(links_[sensor]), directions_, ray_model_.range_min,
-                                    ray_model_.range_max, &robot_);
+  return rawOf(traceBundle(world_, robot_.linkPose(links_[sensor]), directions_, ray_model_.range_min,
+                           ray_model_.range_max, &robot_));
+}
+
+ProximitySensors::Raw ProximitySensors::rawOf(const BundleHit& hit) {
   return Raw{hit.mean_distance, hit.hits ? hit.nearest.surface : std::string(), hit.incidence};
 }
 
@@ -349,7 +381,18 @@ unsigned ProximitySensors::read(int sensor) { return finish(sensor, raw(sensor))
 
 std::array<unsigned, kProximitySensors> ProximitySensors::readAll() {
   std::array<unsigned, kProximitySensors> out{};
-  for (int i = 0; i < kProximitySensors; ++i) out[i] = read(i);
+  if (model_ == Model::LookupTable) {
+    for (int i = 0; i < kProximitySensors; ++i) out[i] = read(i);
+    return out;
+  }
+  // The whole ring with one search of the spaces (castRayBundles); the readings, and the order
+  // of their noise draws, are those of read(0..14).
+  std::vector<Pose> poses;
+  poses.reserve(kProximitySensors);
+  for (const auto& link : links_) poses.push_back(robot_.linkPose(link));
+  const std::vector<BundleHit> hits =
+      traceBundles(world_, poses, directions_, ray_model_.range_min, ray_model_.range_max, &robot_);
+  for (int i = 0; i < kProximitySensors; ++i) out[i] = finish(i, rawOf(hits[i]));
   return out;
 }
 

@@ -50,6 +50,8 @@ class GroundSensors {
   const LogLogResponse& response() const { return response_; }
 
  private:
+  unsigned finish(int sensor, const BundleHit& hit);  ///< effects, noise and response of one bundle
+
   World& world_;
   Robot& robot_;
   IrRayModel model_;

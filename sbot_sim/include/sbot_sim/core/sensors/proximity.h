@@ -93,6 +93,11 @@ struct BundleHit {
 /// ignoring `ignore` (may be null).
 BundleHit traceBundle(const World& world, const Pose& sensor, const std::vector<Vec3>& directions,
                       double range_min, double range_max, const Robot* ignore);
+/// traceBundle for several sensors with the same cone at once (a ring): one search of the spaces
+/// (World::castRayBundles), the same results as traceBundle per sensor.
+std::vector<BundleHit> traceBundles(const World& world, const std::vector<Pose>& sensors,
+                                    const std::vector<Vec3>& directions, double range_min, double range_max,
+                                    const Robot* ignore);
 
 /// Horizontal radius [m] of a level's turret (the widest part, which IR sensors see): the largest
 /// xy extent of the `turret` link's collision shapes; 0.057 if the link has none.
@@ -166,6 +171,7 @@ class ProximitySensors {
     double incidence;
   };
   Raw raw(int sensor) const;
+  static Raw rawOf(const BundleHit& hit);
   Raw rawLut(int sensor) const;
   unsigned finish(int sensor, const Raw& raw);
 
