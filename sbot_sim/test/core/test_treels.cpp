@@ -612,6 +612,22 @@ TEST(TrackCreep, NotForTheBodyDrive) {
 
 // ---- Treels friction of a level (treels.friction_scale) -------------------------------------------
 
+/// How far [m] an s-bot holding (setSpeed(0, 0)) front uphill slides down a slope of `deg` (tilted
+/// gravity) in 2 s after settling for 0.5 s, the track material's mu being `track_mu`.
+double slidHolding(const RobotDescription& d, double deg, double track_mu) {
+  WorldConfig c = flatWorld();
+  c.contact.material_mu["track"] = track_mu;
+  World w(c);
+  const double a = deg * M_PI / 180;
+  dWorldSetGravity(w.odeWorld(), -c.gravity * std::sin(a), 0, -c.gravity * std::cos(a));
+  Robot& r = w.addRobot(d, {0, 0, 0}, "sbot_0");
+  r.setSpeed(0, 0);
+  runFor(w, 0.5);
+  const double x0 = r.basePose().position.x();
+  runFor(w, 2.0);
+  return x0 - r.basePose().position.x();
+}
+
 TEST(TreelsFriction, TheLevelsScaleMultipliesTheTrackMaterialsMu) {
   // A Detailed s-bot holding (setSpeed(0, 0)) front uphill on 35 deg (tilted gravity) on a surface
   // where the track material's mu is 0.5 < tan 35 deg = 0.70: it slides; with the level's friction
@@ -621,17 +637,7 @@ TEST(TreelsFriction, TheLevelsScaleMultipliesTheTrackMaterialsMu) {
     RobotDescription d = loadLevel("detailed");
     ASSERT_EQ(d.treels.friction_scale, 1.0) << "Detailed is the reference level";
     if (doubled) d.treels.friction_scale = 2.0;
-    WorldConfig c = flatWorld();
-    c.contact.material_mu["track"] = 0.5;
-    World w(c);
-    const double a = 35 * M_PI / 180;
-    dWorldSetGravity(w.odeWorld(), -c.gravity * std::sin(a), 0, -c.gravity * std::cos(a));
-    Robot& r = w.addRobot(d, {0, 0, 0}, "sbot_0");
-    r.setSpeed(0, 0);
-    runFor(w, 0.5);
-    const double x0 = r.basePose().position.x();
-    runFor(w, 2.0);
-    slid[doubled] = x0 - r.basePose().position.x();
+    slid[doubled] = slidHolding(d, 35, 0.5);
   }
   EXPECT_GT(slid[0], 0.05) << "mu 0.5 on 35 deg";
   EXPECT_LT(slid[1], 0.005) << "mu 0.5 x 2 on 35 deg";
@@ -647,16 +653,7 @@ TEST(TreelsFriction, ForceLimitLawHoldsEachContactToAFixedForce) {
     RobotDescription d = loadLevel("medium");
     d.treels.friction_law = law;
     d.treels.friction_force_limit = limit;
-    WorldConfig c = flatWorld();
-    World w(c);
-    const double a = 30 * M_PI / 180;
-    dWorldSetGravity(w.odeWorld(), -c.gravity * std::sin(a), 0, -c.gravity * std::cos(a));
-    Robot& r = w.addRobot(d, {0, 0, 0}, "sbot_0");
-    r.setSpeed(0, 0);
-    runFor(w, 0.5);
-    const double x0 = r.basePose().position.x();
-    runFor(w, 2.0);
-    return x0 - r.basePose().position.x();
+    return slidHolding(d, 30, 1.0);
   };
   EXPECT_LT(slid("coulomb", 0.3), 0.01) << "the limit is ignored under Coulomb";
   EXPECT_LT(slid("force_limit", 1.2), 0.01);
