@@ -224,9 +224,10 @@ void parseSidecar(RobotDescription& d) {
   nonNegative(tr.torque_window, "treels.torque_window");
   nonNegative(tr.creep_stiffness, "treels.creep_stiffness");
   requirePositive(tr.friction_scale, file, "treels.friction_scale");
-  tr.friction_law = get<std::string>(t, "friction_law", tr.friction_law, file, "treels.");
-  if (tr.friction_law != "coulomb" && tr.friction_law != "force_limit")
-    throw ConfigError(file, "treels.friction_law", "expected 'coulomb' or 'force_limit', found '" + tr.friction_law + "'");
+  const std::string law = get<std::string>(t, "friction_law", "coulomb", file, "treels.");
+  if (law != "coulomb" && law != "force_limit")
+    throw ConfigError(file, "treels.friction_law", "expected 'coulomb' or 'force_limit', found '" + law + "'");
+  tr.friction_law = law == "force_limit" ? TreelsSemantics::FrictionLaw::ForceLimit : TreelsSemantics::FrictionLaw::Coulomb;
   tr.friction_force_limit = get<double>(t, "friction_force_limit", tr.friction_force_limit, file, "treels.");
   requirePositive(tr.friction_force_limit, file, "treels.friction_force_limit");
   tr.drive = get<std::string>(t, "drive", tr.drive, file, "treels.");

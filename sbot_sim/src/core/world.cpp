@@ -330,7 +330,7 @@ void World::handlePair(dGeomID a, dGeomID b) {
   surface.bounce = cc.bounce;
   surface.bounce_vel = 0.05;
   const Robot* mover = ctx.robot_a ? ctx.robot_a : ctx.robot_b;
-  if (mover && (!ba || !bb) && mover->description().treels.friction_law == "force_limit") {
+  if (mover && (!ba || !bb) && mover->description().treels.friction_law == TreelsSemantics::FrictionLaw::ForceLimit) {
     // The seed's friction law for this level: each terrain contact holds up to a fixed force.
     surface.mode &= ~dContactApprox1;
     surface.mu = mover->description().treels.friction_force_limit;
@@ -465,6 +465,15 @@ void boxCallback(void* data, dGeomID o1, dGeomID o2) {
   q.found->push_back(other);
 }
 
+/// Grows [lo, hi] to hold the segments of `directions` from `origin`, `length` long.
+void growRayBounds(const Vec3& origin, const std::vector<Vec3>& directions, double length, Vec3& lo, Vec3& hi) {
+  for (const Vec3& d : directions) {
+    const Vec3 end = origin + d.normalized() * length;
+    lo = lo.cwiseMin(origin).cwiseMin(end);
+    hi = hi.cwiseMax(origin).cwiseMax(end);
+  }
+}
+
 }  // namespace
 
 void World::findRayCandidates(const Vec3& lo, const Vec3& hi, const Robot* ignore) const {
@@ -495,9 +504,17 @@ std::vector<RayHit> World::castAgainstCandidates(const Vec3& origin, const std::
   return hits;
 }
 
+// One broad-phase search for the box around every ray's segment instead of one per ray (for a
+// sensor's 5-ray cone that was most of the cost of a ray: ODE's space traversal) or per bundle (a
+// 15-sensor ring); a ray can only hit a geom whose bounding box meets its segment's, so the hits
+// are castRay's.
 std::vector<RayHit> World::castRays(const Vec3& origin, const std::vector<Vec3>& directions, double length,
                                     const Robot* ignore) const {
-  return castRayBundles({origin}, {directions}, length, ignore).front();
+  Vec3 lo = origin, hi = origin;
+  growRayBounds(origin, directions, length, lo, hi);
+  if (directions.empty()) ray_candidates_.clear();
+  else findRayCandidates(lo, hi, ignore);
+  return castAgainstCandidates(origin, directions, length, ignore);
 }
 
 std::vector<std::vector<RayHit>> World::castRayBundles(const std::vector<Vec3>& origins,
@@ -505,28 +522,14 @@ std::vector<std::vector<RayHit>> World::castRayBundles(const std::vector<Vec3>& 
                                                        double length, const Robot* ignore) const {
   if (origins.size() != directions.size())
     throw std::invalid_argument("castRayBundles: one direction list per origin");
-  // One broad-phase search for the box around every ray's segment instead of one per ray (for a
-  // sensor's 5-ray cone that was most of the cost of a ray: ODE's space traversal) or per bundle
-  // (a 15-sensor ring); a ray can only hit a geom whose bounding box meets its segment's, so the
-  // hits are castRay's.
   std::vector<std::vector<RayHit>> hits;
+  if (origins.empty()) return hits;
+  Vec3 lo = origins.front(), hi = origins.front();
+  for (std::size_t k = 0; k < origins.size(); ++k) growRayBounds(origins[k], directions[k], length, lo, hi);
+  findRayCandidates(lo, hi, ignore);
   hits.reserve(origins.size());
-  bool any = false;
-  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();
-  for (std::size_t k = 0; k < origins.size(); ++k) {
-    for (const Vec3& d : directions[k]) {
-      const Vec3 end = origins[k] + d.normalized() * length;
-      if (!any) lo = hi = origins[k];
-      lo = lo.cwiseMin(origins[k]).cwiseMin(end);
-      hi = hi.cwiseMax(origins[k]).cwiseMax(end);
-      any = true;
-    }
-  }
-  if (any) findRayCandidates(lo, hi, ignore);
-  for (std::size_t k = 0; k < origins.size(); ++k) {
-    if (!any) ray_candidates_.clear();
+  for (std::size_t k = 0; k < origins.size(); ++k)
     hits.push_back(castAgainstCandidates(origins[k], directions[k], length, ignore));
-  }
   return hits;
 }
 

@@ -649,15 +649,16 @@ TEST(TreelsFriction, ForceLimitLawHoldsEachContactToAFixedForce) {
   // friction_force_limit whatever its load. A Medium s-bot holding (setSpeed(0, 0)) on 30 deg
   // needs 6.5 N x sin 30 = 3.2 N: its six spheres at 1.2 N each hold it, at 0.3 N each (1.8 N in
   // all) it slides; Coulomb (mu 1 > tan 30) holds.
-  auto slid = [](const std::string& law, double limit) {
+  using Law = TreelsSemantics::FrictionLaw;
+  auto slid = [](Law law, double limit) {
     RobotDescription d = loadLevel("medium");
     d.treels.friction_law = law;
     d.treels.friction_force_limit = limit;
     return slidHolding(d, 30, 1.0);
   };
-  EXPECT_LT(slid("coulomb", 0.3), 0.01) << "the limit is ignored under Coulomb";
-  EXPECT_LT(slid("force_limit", 1.2), 0.01);
-  EXPECT_GT(slid("force_limit", 0.3), 0.05);
+  EXPECT_LT(slid(Law::Coulomb, 0.3), 0.01) << "the limit is ignored under Coulomb";
+  EXPECT_LT(slid(Law::ForceLimit, 1.2), 0.01);
+  EXPECT_GT(slid(Law::ForceLimit, 0.3), 0.05);
 }
 
 TEST(TreelsFriction, OnlySimpleCalibratesItsOwn) {

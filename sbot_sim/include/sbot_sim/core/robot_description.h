@@ -63,11 +63,13 @@ struct TreelsSemantics {
   /// Friction of this level's treels abstraction relative to the track material: a driven wheel's
   /// contacts (and Fast's body drive) use mu("track", surface) times this. Dimensionless, > 0.
   double friction_scale = 1.0;
-  /// How this level's contacts with the terrain limit friction. "coulomb": mu times the normal
-  /// force (ODE's friction pyramid, dContactApprox1), mu from the surface materials times
-  /// friction_scale. "force_limit": the seed's own law (Table 2.2 note 4, Vortex's "isotropic
-  /// friction"): every contact holds up to friction_force_limit, whatever its normal force.
-  std::string friction_law = "coulomb";
+  /// How this level's contacts with the terrain limit friction (sidecar friction_law).
+  /// Coulomb ("coulomb"): mu times the normal force (ODE's friction pyramid, dContactApprox1), mu
+  /// from the surface materials times friction_scale. ForceLimit ("force_limit"): the seed's own law
+  /// (Table 2.2 note 4, Vortex's "isotropic friction"): every contact holds up to
+  /// friction_force_limit, whatever its normal force. An enum: World reads it on every contact.
+  enum class FrictionLaw { Coulomb, ForceLimit };
+  FrictionLaw friction_law = FrictionLaw::Coulomb;
   double friction_force_limit = 1.2;  ///< [N] per contact, friction_law force_limit only
   /// "wheels": a velocity motor on every driven hinge (wheel-ground contacts carry the robot);
   /// "body": the tracks drive the chassis directly as an ideal differential drive (Robot, Fast).

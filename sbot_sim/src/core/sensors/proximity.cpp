@@ -79,7 +79,8 @@ BundleHit summarise(const std::vector<Vec3>& dirs, const std::vector<RayHit>& hi
 
 BundleHit traceBundle(const World& world, const Pose& sensor, const std::vector<Vec3>& directions,
                       double range_min, double range_max, const Robot* ignore) {
-  return traceBundles(world, {sensor}, directions, range_min, range_max, ignore).front();
+  const std::vector<Vec3> dirs = worldDirections(sensor, directions);
+  return summarise(dirs, world.castRays(sensor.position, dirs, range_max, ignore), range_min);
 }
 
 std::vector<BundleHit> traceBundles(const World& world, const std::vector<Pose>& sensors,
