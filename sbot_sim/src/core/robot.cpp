@@ -1,6 +1,7 @@
 #include "sbot_sim/core/robot.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 
@@ -80,6 +81,8 @@ void Robot::destroyModel() {
 }
 
 void Robot::build(const Pose& base_pose) {
+  static std::atomic<std::uint64_t> last_build_id{0};
+  build_id_ = ++last_build_id;
   const RobotDescription& d = *model_;
   // 1. Group links into rigid bodies: a fixed joint merges the child into its parent's body.
   //    group_T_link is each link's frame in its group's frame (the group's first link).
@@ -575,6 +578,17 @@ Pose Robot::linkPose(const std::string& link) const {
   auto it = link_index_.find(link);
   if (it == link_index_.end()) throw UnknownName("robot " + name_ + " has no link '" + link + "'");
   return bodyPose(bodies_[it->second.body]) * it->second.body_T_link;
+}
+
+Pose Robot::linkPose(const LinkRef& link) const {
+  if (link.build_ != build_id_) {
+    auto it = link_index_.find(link.name_);
+    if (it == link_index_.end()) throw UnknownName("robot " + name_ + " has no link '" + link.name_ + "'");
+    link.build_ = build_id_;
+    link.body_ = it->second.body;
+    link.body_T_link_ = it->second.body_T_link;
+  }
+  return bodyPose(bodies_[link.body_]) * link.body_T_link_;
 }
 
 Vec3 Robot::linearVelocity() const {

@@ -452,8 +452,18 @@ namespace {
 struct BoxQuery {
   dGeomID box;
   const Robot* ignore;
-  std::vector<dGeomID>* found;
+  std::vector<World::RayCandidate>* found;
 };
+
+/// Whether the segment from `origin` to `end` has a bounding box that meets `aabb` (ODE's layout).
+/// An axis-aligned ground plane's box is the half space below it, so the proximity ring's level
+/// rays skip it (most of a flat-ground ring's ray tests, each a dGeomRaySet and a dCollide).
+bool segmentMayMeet(const Vec3& origin, const Vec3& end, const dReal* aabb) {
+  for (int k = 0; k < 3; ++k) {
+    if (std::max(origin[k], end[k]) < aabb[2 * k] || std::min(origin[k], end[k]) > aabb[2 * k + 1]) return false;
+  }
+  return true;
+}
 
 // Collect the geoms whose bounding boxes meet the query box.
 void boxCallback(void* data, dGeomID o1, dGeomID o2) {
@@ -462,13 +472,16 @@ void boxCallback(void* data, dGeomID o1, dGeomID o2) {
   const dGeomID other = o1 == q.box ? o2 : o1;
   const GeomInfo* gi = infoOf(other);
   if (gi && q.ignore && gi->robot == q.ignore) return;
-  q.found->push_back(other);
+  World::RayCandidate c;
+  c.geom = other;
+  dGeomGetAABB(other, c.aabb);
+  q.found->push_back(c);
 }
 
-/// Grows [lo, hi] to hold the segments of `directions` from `origin`, `length` long.
-void growRayBounds(const Vec3& origin, const std::vector<Vec3>& directions, double length, Vec3& lo, Vec3& hi) {
-  for (const Vec3& d : directions) {
-    const Vec3 end = origin + d.normalized() * length;
+/// Grows [lo, hi] to hold the segments of the n `directions` from `origin`, `length` long.
+void growRayBounds(const Vec3& origin, const Vec3* directions, std::size_t n, double length, Vec3& lo, Vec3& hi) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 end = origin + directions[i].normalized() * length;
     lo = lo.cwiseMin(origin).cwiseMin(end);
     hi = hi.cwiseMax(origin).cwiseMax(end);
   }
@@ -488,20 +501,25 @@ void World::findRayCandidates(const Vec3& lo, const Vec3& hi, const Robot* ignor
   dSpaceCollide2(query_box_, reinterpret_cast<dGeomID>(static_space_), &box, &boxCallback);
 }
 
-std::vector<RayHit> World::castAgainstCandidates(const Vec3& origin, const std::vector<Vec3>& directions,
-                                                 double length, const Robot* ignore) const {
+void World::castAgainstCandidates(const Vec3& origin, const Vec3* directions, std::size_t n, double length,
+                                  const Robot* ignore, RayHit* hits) const {
   RayHit miss;
   miss.distance = length;
-  std::vector<RayHit> hits(directions.size(), miss);
-  if (ray_candidates_.empty()) return hits;
+  std::fill(hits, hits + n, miss);
+  if (ray_candidates_.empty()) return;
   dGeomID ray = queryRay(length);
-  for (std::size_t i = 0; i < directions.size(); ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
     const Vec3 d = directions[i].normalized();
-    dGeomRaySet(ray, origin.x(), origin.y(), origin.z(), d.x(), d.y(), d.z());
+    const Vec3 end = origin + d * length;
+    bool ray_set = false;
     RayQuery query{ignore, &hits[i]};
-    for (dGeomID g : ray_candidates_) rayAgainstGeom(query, ray, g);
+    for (const RayCandidate& c : ray_candidates_) {
+      if (!segmentMayMeet(origin, end, c.aabb)) continue;
+      if (!ray_set) dGeomRaySet(ray, origin.x(), origin.y(), origin.z(), d.x(), d.y(), d.z());
+      ray_set = true;
+      rayAgainstGeom(query, ray, c.geom);
+    }
   }
-  return hits;
 }
 
 // One broad-phase search for the box around every ray's segment instead of one per ray (for a
@@ -511,25 +529,28 @@ std::vector<RayHit> World::castAgainstCandidates(const Vec3& origin, const std::
 std::vector<RayHit> World::castRays(const Vec3& origin, const std::vector<Vec3>& directions, double length,
                                     const Robot* ignore) const {
   Vec3 lo = origin, hi = origin;
-  growRayBounds(origin, directions, length, lo, hi);
+  growRayBounds(origin, directions.data(), directions.size(), length, lo, hi);
   if (directions.empty()) ray_candidates_.clear();
   else findRayCandidates(lo, hi, ignore);
-  return castAgainstCandidates(origin, directions, length, ignore);
+  std::vector<RayHit> hits(directions.size());
+  castAgainstCandidates(origin, directions.data(), directions.size(), length, ignore, hits.data());
+  return hits;
 }
 
-std::vector<std::vector<RayHit>> World::castRayBundles(const std::vector<Vec3>& origins,
-                                                       const std::vector<std::vector<Vec3>>& directions,
-                                                       double length, const Robot* ignore) const {
-  if (origins.size() != directions.size())
-    throw std::invalid_argument("castRayBundles: one direction list per origin");
-  std::vector<std::vector<RayHit>> hits;
+std::vector<RayHit> World::castRayBundles(const std::vector<Vec3>& origins, const std::vector<Vec3>& directions,
+                                          double length, const Robot* ignore) const {
+  if (origins.empty() ? !directions.empty() : directions.size() % origins.size() != 0)
+    throw std::invalid_argument("castRayBundles: " + std::to_string(directions.size()) +
+                                " directions do not make equal bundles for " + std::to_string(origins.size()) +
+                                " origins");
+  std::vector<RayHit> hits(directions.size());
   if (origins.empty()) return hits;
+  const std::size_t n = directions.size() / origins.size();
   Vec3 lo = origins.front(), hi = origins.front();
-  for (std::size_t k = 0; k < origins.size(); ++k) growRayBounds(origins[k], directions[k], length, lo, hi);
+  for (std::size_t k = 0; k < origins.size(); ++k) growRayBounds(origins[k], &directions[k * n], n, length, lo, hi);
   findRayCandidates(lo, hi, ignore);
-  hits.reserve(origins.size());
   for (std::size_t k = 0; k < origins.size(); ++k)
-    hits.push_back(castAgainstCandidates(origins[k], directions[k], length, ignore));
+    castAgainstCandidates(origins[k], &directions[k * n], n, length, ignore, &hits[k * n]);
   return hits;
 }
 

@@ -222,5 +222,47 @@ TEST(ModelSwitch, SolverIterationsFollowTheLevelsInTheWorld) {
   EXPECT_EQ(pinned.solverIterations(), 20);
 }
 
+// A LinkRef (what sensors hold) gives linkPose(name)'s pose before and after the robot is rebuilt:
+// by a level switch (other bodies, other link frames) and by welding the turret (the turret's links
+// merge into the treels' body).
+TEST(ModelSwitch, LinkRefsFollowTheRobotThroughRebuilds) {
+  WorldConfig c = flatWorld();
+  c.lock_idle_turret = true;  // a turret at rest is welded (a rebuild), a turning one unwelded
+  World w(c);
+  Robot& r = w.addRobot(loadLevel("medium"), {0, 0, 0}, "sbot_0");
+  r.setSpeed(30, 10);
+  r.setTurretRotation(20);
+  const LinkRef ir("ir_3"), ground("ground_1"), light("light_5");
+  auto expectSame = [&](const std::string& when) {
+    for (const LinkRef* l : {&ir, &ground, &light}) {
+      const Pose by_ref = r.linkPose(*l), by_name = r.linkPose(l->name());
+      EXPECT_LT((by_ref.position - by_name.position).norm(), 1e-12) << l->name() << " " << when;
+      EXPECT_LT(by_ref.orientation.angularDistance(by_name.orientation), 1e-12) << l->name() << " " << when;
+    }
+  };
+  runFor(w, 0.5);
+  expectSame("before");
+  const Vec3 medium_ir = r.linkPose(ir).position;
+  w.switchLevel("sbot_0", loadLevel("detailed"));
+  expectSame("after the switch to detailed");
+  runFor(w, 0.5);
+  expectSame("driving as detailed");
+  EXPECT_GT((r.linkPose(ir).position - medium_ir).norm(), 1e-3) << "the robot moved on";
+  for (int i = 0; i < 1000 && !r.turretLocked(); ++i) w.step();
+  ASSERT_TRUE(r.turretLocked()) << "the idle turret should have been welded";
+  expectSame("with the turret welded");
+  runFor(w, 0.3);
+  expectSame("driving welded");
+  r.setTurretRotation(-20);
+  w.step();
+  ASSERT_FALSE(r.turretLocked()) << "a turret given a new target is unwelded";
+  expectSame("unwelded");
+  // One LinkRef read on two robots is resolved for each.
+  Robot& other = w.addRobot(loadLevel("simple"), {1, 0, 0}, "sbot_1");
+  EXPECT_LT((other.linkPose(ir).position - other.linkPose("ir_3").position).norm(), 1e-12);
+  expectSame("after reading another robot");
+  EXPECT_THROW(r.linkPose(LinkRef("no_such_link")), UnknownName);
+}
+
 }  // namespace
 }  // namespace sbot

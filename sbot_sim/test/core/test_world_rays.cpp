@@ -1,4 +1,5 @@
-// World::castRays (a sensor's ray bundle searched once by its bounding box) must see exactly what
+// World::castRays (a sensor's ray bundle searched once by its bounding box, each ray then tested
+// only against the geoms whose bounding boxes meet its segment's) must see exactly what
 // World::castRay sees ray by ray: on boxes turned every way, other robots, the ground plane and a
 // rough height field, with and without the sensing robot ignored.
 #include <gtest/gtest.h>
@@ -84,34 +85,38 @@ TEST(WorldRays, RingOfBundlesSeesWhatEachBundleSees) {
   runFor(w, 0.2);
   int hits = 0;
   for (int ring = 0; ring < 50; ++ring) {
-    std::vector<Vec3> origins;
-    std::vector<std::vector<Vec3>> dirs;
-    for (int k = 0; k < 15; ++k) {  // a ring around the robot, each sensor a 5-ray cone outwards
+    std::vector<Vec3> origins, dirs;  // bundle k: dirs[5k .. 5k + 4]
+    for (int k = 0; k < 15; ++k) {    // a ring around the robot, each sensor a 5-ray cone outwards
       const double bearing = 2 * M_PI * k / 15 + 0.1 * u(rng);
       const Vec3 out(std::cos(bearing), std::sin(bearing), 0.1 * u(rng));
       origins.push_back(Vec3(0, 0, 0.06) + 0.06 * Vec3(out.x(), out.y(), 0));
-      std::vector<Vec3> cone;
-      for (int i = 0; i < 5; ++i) cone.push_back((out + 0.2 * Vec3(u(rng), u(rng), u(rng))).normalized());
-      dirs.push_back(cone);
+      for (int i = 0; i < 5; ++i) dirs.push_back((out + 0.2 * Vec3(u(rng), u(rng), u(rng))).normalized());
     }
     const double length = 0.05 + 0.25 * (u(rng) + 1);
     const Robot* ignore = ring % 2 ? &a : nullptr;
-    const auto together = w.castRayBundles(origins, dirs, length, ignore);
-    ASSERT_EQ(together.size(), origins.size());
+    const std::vector<RayHit> together = w.castRayBundles(origins, dirs, length, ignore);
+    ASSERT_EQ(together.size(), dirs.size());
     for (std::size_t k = 0; k < origins.size(); ++k) {
-      const std::vector<RayHit> alone = w.castRays(origins[k], dirs[k], length, ignore);
-      ASSERT_EQ(together[k].size(), alone.size());
+      const std::vector<Vec3> cone(dirs.begin() + 5 * k, dirs.begin() + 5 * k + 5);
+      const std::vector<RayHit> alone = w.castRays(origins[k], cone, length, ignore);
+      ASSERT_EQ(alone.size(), 5u);
       for (std::size_t i = 0; i < alone.size(); ++i) {
-        ASSERT_EQ(together[k][i].hit, alone[i].hit) << "ring " << ring << " bundle " << k << " ray " << i;
-        EXPECT_DOUBLE_EQ(together[k][i].distance, alone[i].distance);
-        EXPECT_EQ(together[k][i].surface, alone[i].surface);
-        EXPECT_EQ(together[k][i].robot, alone[i].robot);
+        const RayHit& t = together[5 * k + i];
+        ASSERT_EQ(t.hit, alone[i].hit) << "ring " << ring << " bundle " << k << " ray " << i;
+        EXPECT_DOUBLE_EQ(t.distance, alone[i].distance);
+        EXPECT_EQ(t.surface, alone[i].surface);
+        EXPECT_EQ(t.robot, alone[i].robot);
         hits += alone[i].hit;
       }
     }
   }
   EXPECT_GT(hits, 500) << "the rings must actually hit things for the comparison to mean anything";
-  EXPECT_THROW(w.castRayBundles({Vec3::Zero()}, {}, 0.1, nullptr), std::invalid_argument);
+  // Directions that do not split into equal bundles are refused.
+  EXPECT_THROW(w.castRayBundles({Vec3::Zero(), Vec3::UnitX()}, {Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()}, 0.1,
+                                nullptr),
+               std::invalid_argument);
+  EXPECT_THROW(w.castRayBundles({}, {Vec3::UnitX()}, 0.1, nullptr), std::invalid_argument);
+  EXPECT_TRUE(w.castRayBundles({}, {}, 0.1, nullptr).empty());
 }
 
 TEST(WorldRays, BundleSeesWhatSingleRaysSeeOnRoughTerrain) {
@@ -124,6 +129,27 @@ TEST(WorldRays, BundleSeesWhatSingleRaysSeeOnRoughTerrain) {
   int hits = 0;
   expectSameHits(w, nullptr, rng, 300, &hits);
   EXPECT_GT(hits, 250);
+}
+
+// The ground plane's bounding box is the half space below it: rays that end on it, just short of
+// it or just above it must be told apart exactly as castRay does.
+TEST(WorldRays, RaysEndingAtTheGroundPlaneAreCulledOnlyWhenTheyCannotReachIt) {
+  World w(flatWorld());
+  const Vec3 origin(0, 0, 0.1);
+  std::vector<Vec3> dirs;
+  for (double z : {-1.0, -0.5, -1e-3, 0.0, 1e-3}) dirs.push_back(Vec3(1, 0, z).normalized());
+  for (double length : {0.0999, 0.1, 0.1001, 0.2, 100.0}) {
+    const std::vector<RayHit> bundle = w.castRays(origin, dirs, length, nullptr);
+    for (std::size_t i = 0; i < dirs.size(); ++i) {
+      const RayHit one = w.castRay(origin, dirs[i], length, nullptr);
+      ASSERT_EQ(bundle[i].hit, one.hit) << "length " << length << " ray " << i;
+      EXPECT_DOUBLE_EQ(bundle[i].distance, one.distance);
+    }
+  }
+  // Straight down 0.2 m from 0.1 m: the plane, 0.1 m away; level: nothing.
+  EXPECT_TRUE(w.castRays(origin, {-Vec3::UnitZ()}, 0.2, nullptr)[0].hit);
+  EXPECT_NEAR(w.castRays(origin, {-Vec3::UnitZ()}, 0.2, nullptr)[0].distance, 0.1, 1e-12);
+  EXPECT_FALSE(w.castRays(origin, {Vec3::UnitX()}, 0.2, nullptr)[0].hit);
 }
 
 TEST(WorldRays, NothingInReachGivesMissesAtFullLength) {

@@ -13,6 +13,7 @@
 
 #include "sbot_sim/core/effects.h"
 #include "sbot_sim/core/geom_info.h"
+#include "sbot_sim/core/link_ref.h"
 #include "sbot_sim/core/random_streams.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/types.h"
@@ -21,6 +22,7 @@
 namespace sbot {
 
 class World;
+
 
 struct JointState {
   std::string name;
@@ -108,6 +110,8 @@ class Robot {
   Pose basePose() const;
   /// World pose of any URDF link, including massless sensor frames merged into a body.
   Pose linkPose(const std::string& link) const;
+  /// linkPose through a LinkRef: the same pose, the name looked up once per build of the robot.
+  Pose linkPose(const LinkRef& link) const;
   bool hasLink(const std::string& link) const { return link_index_.count(link) != 0; }
   Vec3 linearVelocity() const;   ///< of base_link's body, world frame [m/s]
   Vec3 angularVelocity() const;  ///< world frame [rad/s]
@@ -236,6 +240,9 @@ class Robot {
   std::map<std::string, dJointID> loop_index_;  ///< loop joint name -> joint (hingeJoint() finds them)
   std::map<std::string, int> hinge_index_;
   std::map<std::string, LinkFrame> link_index_;
+  /// Unique over the process and every build() of every robot: a LinkRef resolved in another
+  /// build (of this robot, or of another) is looked up again.
+  std::uint64_t build_id_ = 0;
   std::vector<int> left_hinges_, right_hinges_;
   int turret_hinge_ = -1;
   Pose base_body_T_base_;                ///< base_link in its body's (centre of mass) frame

@@ -90,11 +90,11 @@ class World {
   /// but the spaces are searched once, for the box that bounds the whole bundle.
   std::vector<RayHit> castRays(const Vec3& origin, const std::vector<Vec3>& directions, double length,
                                const Robot* ignore) const;
-  /// Several bundles (a sensor ring: bundle k = `directions[k]` from `origins[k]`) with one search of
+  /// Several bundles of n rays each (a sensor ring; n = directions.size() / origins.size()): bundle k
+  /// is directions[k n .. k n + n - 1] from origins[k], and hits come in the same order. One search of
   /// the spaces, for the box around all of them: the same hits as castRays per bundle.
-  std::vector<std::vector<RayHit>> castRayBundles(const std::vector<Vec3>& origins,
-                                                  const std::vector<std::vector<Vec3>>& directions, double length,
-                                                  const Robot* ignore) const;
+  std::vector<RayHit> castRayBundles(const std::vector<Vec3>& origins, const std::vector<Vec3>& directions,
+                                     double length, const Robot* ignore) const;
 
   void addEffect(EffectPtr effect) { effects_.push_back(std::move(effect)); }
   const std::vector<EffectPtr>& effects() const { return effects_; }
@@ -112,6 +112,13 @@ class World {
   dSpaceID staticSpace() const { return static_space_; }
   dJointGroupID contactGroup() const { return contacts_; }
 
+  /// Internal (public for the query callbacks): a geom within castRays' box, with its bounding box
+  /// [min x, max x, min y, max y, min z, max z] (ODE's layout): a ray is only tested against the
+  /// geoms whose boxes meet its own segment's.
+  struct RayCandidate {
+    dGeomID geom;
+    dReal aabb[6];
+  };
   // internal: collision callback trampoline
   void handlePair(dGeomID a, dGeomID b);
 
@@ -128,16 +135,17 @@ class World {
   /// ray cost ~10 % of a sensor-reading Medium step. Makes a World unsafe to query from two threads.
   mutable dGeomID query_ray_ = nullptr;
   mutable dGeomID query_box_ = nullptr;  ///< castRays' bounding box, also in no space
-  mutable std::vector<dGeomID> ray_candidates_;  ///< castRays' geoms within that box (reused)
+  mutable std::vector<RayCandidate> ray_candidates_;  ///< castRays' geoms within that box (reused)
   int solver_iterations_ = 0;
   bool exact_solver_ = false;     ///< config_.solver == "exact"
   void updateSolverIterations();  ///< after a robot came, went or changed level
   dGeomID queryRay(double length) const;  ///< query_ray_ with this length
   /// Fills ray_candidates_ with the geoms (not `ignore`'s) whose bounding boxes meet [lo, hi].
   void findRayCandidates(const Vec3& lo, const Vec3& hi, const Robot* ignore) const;
-  /// Casts the rays from `origin` against ray_candidates_ only; hits[i] for directions[i].
-  std::vector<RayHit> castAgainstCandidates(const Vec3& origin, const std::vector<Vec3>& directions, double length,
-                                            const Robot* ignore) const;
+  /// Casts the n rays `directions` from `origin` against ray_candidates_ only; the hit of directions[i]
+  /// into hits[i] (each a miss at `length` unless something nearer is hit).
+  void castAgainstCandidates(const Vec3& origin, const Vec3* directions, std::size_t n, double length,
+                             const Robot* ignore, RayHit* hits) const;
   dJointGroupID contacts_ = nullptr;
   /// This step's contacts on driven treels wheels, with ODE's force feedback (Robot::driveWheelLoad).
   /// A deque: ODE keeps pointers to the feedback records while the step runs.

@@ -38,9 +38,9 @@ GroundSensors::GroundSensors(World& world, Robot& robot)
       response_(groundResponse(model_)),
       noise_(extraNumber(robot.description(), "ground_noise", 0.1)) {
   for (int i = 0; i < kGroundSensors; ++i) {
-    links_[i] = "ground_" + std::to_string(i);
-    if (!robot.hasLink(links_[i])) {
-      throw ConfigError(robot.description().urdf_path, "link " + links_[i], "missing (needed by the ground sensors)");
+    links_[i] = LinkRef("ground_" + std::to_string(i));
+    if (!robot.hasLink(links_[i].name())) {
+      throw ConfigError(robot.description().urdf_path, "link " + links_[i].name(), "missing (needed by the ground sensors)");
     }
   }
 }

@@ -24,9 +24,9 @@ LightSensors::LightSensors(World& world, Robot& robot, const Environment& env)
   params_.max_reading = extraNumber(d, "light_sensor_max_units", params_.max_reading);
   params_.led_unit = extraNumber(d, "led_unit_mcd", params_.led_unit);
   for (int i = 0; i < kLightSensors; ++i) {
-    links_[i] = "light_" + std::to_string(i);
-    if (!robot.hasLink(links_[i])) {
-      throw ConfigError(d.urdf_path, "link " + links_[i], "missing (needed by the light sensors)");
+    links_[i] = LinkRef("light_" + std::to_string(i));
+    if (!robot.hasLink(links_[i].name())) {
+      throw ConfigError(d.urdf_path, "link " + links_[i].name(), "missing (needed by the light sensors)");
     }
   }
 }

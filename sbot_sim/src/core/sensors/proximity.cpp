@@ -45,20 +45,17 @@ LogLogResponse proximityResponse(const IrRayModel& model) {
 
 namespace {
 
-/// The sensor's cone in world directions.
-std::vector<Vec3> worldDirections(const Pose& sensor, const std::vector<Vec3>& directions) {
-  std::vector<Vec3> dirs;
-  dirs.reserve(directions.size());
+/// Appends the sensor's cone, turned into world directions, to `dirs`.
+void appendWorldDirections(const Pose& sensor, const std::vector<Vec3>& directions, std::vector<Vec3>& dirs) {
   for (const Vec3& local : directions) dirs.push_back(sensor.orientation * local);
-  return dirs;
 }
 
-/// One bundle's hits summarised: how many, their mean distance, the nearest and its incidence.
-BundleHit summarise(const std::vector<Vec3>& dirs, const std::vector<RayHit>& hits, double range_min) {
+/// One bundle's n hits summarised: how many, their mean distance, the nearest and its incidence.
+BundleHit summarise(const Vec3* dirs, const RayHit* hits, std::size_t n, double range_min) {
   BundleHit out;
   double sum = 0;
   double nearest = kInf;
-  for (std::size_t i = 0; i < dirs.size(); ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
     const Vec3& dir = dirs[i];
     const RayHit& h = hits[i];
     if (!h.hit) continue;
@@ -79,23 +76,28 @@ BundleHit summarise(const std::vector<Vec3>& dirs, const std::vector<RayHit>& hi
 
 BundleHit traceBundle(const World& world, const Pose& sensor, const std::vector<Vec3>& directions,
                       double range_min, double range_max, const Robot* ignore) {
-  const std::vector<Vec3> dirs = worldDirections(sensor, directions);
-  return summarise(dirs, world.castRays(sensor.position, dirs, range_max, ignore), range_min);
+  std::vector<Vec3> dirs;
+  dirs.reserve(directions.size());
+  appendWorldDirections(sensor, directions, dirs);
+  const std::vector<RayHit> hits = world.castRays(sensor.position, dirs, range_max, ignore);
+  return summarise(dirs.data(), hits.data(), dirs.size(), range_min);
 }
 
 std::vector<BundleHit> traceBundles(const World& world, const std::vector<Pose>& sensors,
                                     const std::vector<Vec3>& directions, double range_min, double range_max,
                                     const Robot* ignore) {
-  std::vector<Vec3> origins;
-  std::vector<std::vector<Vec3>> dirs;
+  std::vector<Vec3> origins, dirs;  // bundle k: dirs[k n .. k n + n - 1], n = directions.size()
+  origins.reserve(sensors.size());
+  dirs.reserve(sensors.size() * directions.size());
   for (const Pose& p : sensors) {
     origins.push_back(p.position);
-    dirs.push_back(worldDirections(p, directions));
+    appendWorldDirections(p, directions, dirs);
   }
-  const std::vector<std::vector<RayHit>> hits = world.castRayBundles(origins, dirs, range_max, ignore);
+  const std::vector<RayHit> hits = world.castRayBundles(origins, dirs, range_max, ignore);
+  const std::size_t n = directions.size();
   std::vector<BundleHit> out;
   out.reserve(sensors.size());
-  for (std::size_t k = 0; k < sensors.size(); ++k) out.push_back(summarise(dirs[k], hits[k], range_min));
+  for (std::size_t k = 0; k < sensors.size(); ++k) out.push_back(summarise(&dirs[k * n], &hits[k * n], n, range_min));
   return out;
 }
 
@@ -312,9 +314,9 @@ ProximitySensors::ProximitySensors(World& world, Robot& robot, Model model, cons
       noise_(extraNumber(robot.description(), "ir_noise", 0.1)) {
   if (model_ == Model::LookupTable && !lut_) throw std::invalid_argument("IR look-up table model needs a table");
   for (int i = 0; i < kProximitySensors; ++i) {
-    links_[i] = "ir_" + std::to_string(i);
-    if (!robot.hasLink(links_[i])) {
-      throw ConfigError(robot.description().urdf_path, "link " + links_[i], "missing (needed by the IR sensors)");
+    links_[i] = LinkRef("ir_" + std::to_string(i));
+    if (!robot.hasLink(links_[i].name())) {
+      throw ConfigError(robot.description().urdf_path, "link " + links_[i].name(), "missing (needed by the IR sensors)");
     }
   }
 }

@@ -22,9 +22,9 @@ SoundSensors::SoundSensors(World& world, Robot& robot, const Environment& env)
     : world_(world), robot_(robot), env_(env) {
   params_.noise = extraNumber(robot.description(), "sound_noise", params_.noise);
   for (int i = 0; i < kMicrophones; ++i) {
-    links_[i] = "mic_" + std::to_string(i);
-    if (!robot.hasLink(links_[i])) {
-      throw ConfigError(robot.description().urdf_path, "link " + links_[i], "missing (needed by the microphones)");
+    links_[i] = LinkRef("mic_" + std::to_string(i));
+    if (!robot.hasLink(links_[i].name())) {
+      throw ConfigError(robot.description().urdf_path, "link " + links_[i].name(), "missing (needed by the microphones)");
     }
   }
 }

@@ -58,7 +58,7 @@ class GroundSensors {
   std::vector<Vec3> directions_;
   LogLogResponse response_;
   double noise_;
-  std::array<std::string, kGroundSensors> links_;
+  std::array<LinkRef, kGroundSensors> links_;
 };
 
 }  // namespace sensors

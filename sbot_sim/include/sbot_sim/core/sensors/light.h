@@ -42,6 +42,7 @@
 #include <string>
 #include <vector>
 
+#include "sbot_sim/core/link_ref.h"
 #include "sbot_sim/core/sensors/environment.h"
 #include "sbot_sim/core/sensors/sensor_common.h"
 #include "sbot_sim/core/types.h"
@@ -94,7 +95,7 @@ class LightSensors {
   Robot& robot_;
   const Environment& env_;
   LightSensorParams params_;
-  std::array<std::string, kLightSensors> links_;
+  std::array<LinkRef, kLightSensors> links_;
 };
 
 }  // namespace sensors

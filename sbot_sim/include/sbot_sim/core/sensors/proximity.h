@@ -55,6 +55,7 @@
 #include <string>
 #include <vector>
 
+#include "sbot_sim/core/link_ref.h"
 #include "sbot_sim/core/sensors/sensor_common.h"
 #include "sbot_sim/core/world.h"
 
@@ -183,7 +184,7 @@ class ProximitySensors {
   std::vector<Vec3> directions_;
   LogLogResponse response_;
   double noise_;
-  std::array<std::string, kProximitySensors> links_;
+  std::array<LinkRef, kProximitySensors> links_;
 };
 
 }  // namespace sensors

@@ -34,6 +34,7 @@
 #include <array>
 #include <string>
 
+#include "sbot_sim/core/link_ref.h"
 #include "sbot_sim/core/sensors/environment.h"
 #include "sbot_sim/core/types.h"
 
@@ -78,7 +79,7 @@ class SoundSensors {
   Robot& robot_;
   const Environment& env_;
   SoundParams params_;
-  std::array<std::string, kMicrophones> links_;
+  std::array<LinkRef, kMicrophones> links_;
 };
 
 }  // namespace sensors
