@@ -211,7 +211,11 @@ TEST(ModelSwitch, SolverIterationsFollowTheLevelsInTheWorld) {
   w.switchLevel("b", loadLevel("detailed"));
   EXPECT_EQ(w.solverIterations(), loadLevel("detailed").solver_iterations);
   EXPECT_GT(w.solverIterations(), 20);
-  w.switchLevel("b", loadLevel("medium"));
+  w.switchLevel("b", loadLevel("medium"));  // Medium's force-limited treels want 25
+  EXPECT_EQ(w.solverIterations(), loadLevel("medium").solver_iterations);
+  EXPECT_GT(w.solverIterations(), 20);
+  EXPECT_LT(w.solverIterations(), loadLevel("detailed").solver_iterations);
+  w.switchLevel("b", loadLevel("basic"));
   EXPECT_EQ(w.solverIterations(), 20);
   w.switchLevel("a", loadLevel("detailed"));
   w.removeRobot("a");
