@@ -104,6 +104,7 @@ World::World(const WorldConfig& config) : config_(config) {
   dSpaceSetSublevel(static_space_, 1);  // as the robots' spaces: dSpaceCollide2 iterates the static one
   contacts_ = dJointGroupCreate(0);
   buildTerrain();
+  indexTerrain();
   connections_ = std::make_unique<ConnectionManager>(*this);
 }
 
@@ -275,10 +276,7 @@ void World::step() {
   for (auto& r : robots_) r->applyCommands(dt, effects_);
   lap(profile_.commands_s);
   dSpaceCollide(space_, this, &nearCallback);  // robot against robot
-  // Robot against terrain: each static geom's AABB against the robot's space, then the robot's
-  // geoms against the few static geoms that overlap it.
-  for (auto& r : robots_)
-    dSpaceCollide2(reinterpret_cast<dGeomID>(static_space_), reinterpret_cast<dGeomID>(r->space()), this, &nearCallback);
+  for (auto& r : robots_) collideWithTerrain(*r);
   lap(profile_.collision_s);
   // QuickStep shuffles constraints with ODE's one global generator; reseeding it from the step
   // count makes every run of a scenario bit-identical whatever other worlds did in this process.
@@ -296,6 +294,56 @@ void World::step() {
   ++profile_.steps;
   time_ += dt;
   ++steps_;
+}
+
+namespace {
+
+/// ODE's bounding-box overlap test (collideAABBs): boxes that touch meet.
+bool boxesMeet(const dReal* a, const dReal* b) {
+  return !(a[0] > b[1] || a[1] < b[0] || a[2] > b[3] || a[3] < b[2] || a[4] > b[5] || a[5] < b[4]);
+}
+
+}  // namespace
+
+void World::indexTerrain() {
+  // In static_space_'s own order (ODE's list, newest first), the order its collide2 visits them.
+  terrain_index_.clear();
+  const int n = dSpaceGetNumGeoms(static_space_);
+  for (int i = 0; i < n; ++i) {
+    BoxedGeom t;
+    t.geom = dSpaceGetGeom(static_space_, i);
+    dGeomGetAABB(t.geom, t.aabb);
+    terrain_index_.push_back(t);
+  }
+}
+
+// What dSpaceCollide2(static_space_, robot space) did, pair for pair and in the same order, so runs
+// are unchanged: ODE (the static space a sublevel above the robots') tested every static geom's box
+// against the robot space's, then each static geom that met it against the robot's geoms. Here the
+// first pass runs over a flat array of boxes computed once (the terrain never moves) instead of
+// ODE's list of geoms with their per-geom checks: it was ~4 % of a model-switching run on a course
+// of ~250 boxes.
+void World::collideWithTerrain(Robot& r) {
+  dReal robot_box[6];
+  dGeomGetAABB(reinterpret_cast<dGeomID>(r.space()), robot_box);
+  bool robot_geoms_read = false;
+  for (const BoxedGeom& t : terrain_index_) {
+    if (!boxesMeet(t.aabb, robot_box)) continue;
+    if (!robot_geoms_read) {
+      // As ODE's collide2 does: clears the robot geoms' dirty flags, which decide the order of its
+      // list (dGeomMoved puts a moved geom first unless it is still flagged) and so of the contacts.
+      dSpaceClean(r.space());
+      const int n = dSpaceGetNumGeoms(r.space());
+      robot_geoms_.resize(n);
+      for (int i = 0; i < n; ++i) {
+        robot_geoms_[i].geom = dSpaceGetGeom(r.space(), i);
+        dGeomGetAABB(robot_geoms_[i].geom, robot_geoms_[i].aabb);
+      }
+      robot_geoms_read = true;
+    }
+    for (const BoxedGeom& g : robot_geoms_)
+      if (boxesMeet(g.aabb, t.aabb)) handlePair(t.geom, g.geom);
+  }
 }
 
 void World::handlePair(dGeomID a, dGeomID b) {
@@ -452,7 +500,7 @@ namespace {
 struct BoxQuery {
   dGeomID box;
   const Robot* ignore;
-  std::vector<World::RayCandidate>* found;
+  std::vector<World::BoxedGeom>* found;
 };
 
 /// Whether the segment from `origin` to `end` has a bounding box that meets `aabb` (ODE's layout).
@@ -472,22 +520,28 @@ void boxCallback(void* data, dGeomID o1, dGeomID o2) {
   const dGeomID other = o1 == q.box ? o2 : o1;
   const GeomInfo* gi = infoOf(other);
   if (gi && q.ignore && gi->robot == q.ignore) return;
-  World::RayCandidate c;
+  World::BoxedGeom c;
   c.geom = other;
   dGeomGetAABB(other, c.aabb);
   q.found->push_back(c);
 }
 
-/// Grows [lo, hi] to hold the segments of the n `directions` from `origin`, `length` long.
+/// Grows [lo, hi] to hold the segments of the n unit `directions` from `origin`, `length` long.
 void growRayBounds(const Vec3& origin, const Vec3* directions, std::size_t n, double length, Vec3& lo, Vec3& hi) {
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 end = origin + directions[i].normalized() * length;
+    const Vec3 end = origin + directions[i] * length;
     lo = lo.cwiseMin(origin).cwiseMin(end);
     hi = hi.cwiseMax(origin).cwiseMax(end);
   }
 }
 
 }  // namespace
+
+const Vec3* World::unitDirections(const std::vector<Vec3>& directions) const {
+  ray_units_.resize(directions.size());
+  for (std::size_t i = 0; i < directions.size(); ++i) ray_units_[i] = directions[i].normalized();
+  return ray_units_.data();
+}
 
 void World::findRayCandidates(const Vec3& lo, const Vec3& hi, const Robot* ignore) const {
   constexpr double kMargin = 1e-6;  // [m] keeps the box's sides from vanishing (axis-aligned rays)
@@ -509,11 +563,11 @@ void World::castAgainstCandidates(const Vec3& origin, const Vec3* directions, st
   if (ray_candidates_.empty()) return;
   dGeomID ray = queryRay(length);
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 d = directions[i].normalized();
+    const Vec3& d = directions[i];
     const Vec3 end = origin + d * length;
     bool ray_set = false;
     RayQuery query{ignore, &hits[i]};
-    for (const RayCandidate& c : ray_candidates_) {
+    for (const BoxedGeom& c : ray_candidates_) {
       if (!segmentMayMeet(origin, end, c.aabb)) continue;
       if (!ray_set) dGeomRaySet(ray, origin.x(), origin.y(), origin.z(), d.x(), d.y(), d.z());
       ray_set = true;
@@ -528,12 +582,13 @@ void World::castAgainstCandidates(const Vec3& origin, const Vec3* directions, st
 // are castRay's.
 std::vector<RayHit> World::castRays(const Vec3& origin, const std::vector<Vec3>& directions, double length,
                                     const Robot* ignore) const {
+  const Vec3* units = unitDirections(directions);
   Vec3 lo = origin, hi = origin;
-  growRayBounds(origin, directions.data(), directions.size(), length, lo, hi);
+  growRayBounds(origin, units, directions.size(), length, lo, hi);
   if (directions.empty()) ray_candidates_.clear();
   else findRayCandidates(lo, hi, ignore);
   std::vector<RayHit> hits(directions.size());
-  castAgainstCandidates(origin, directions.data(), directions.size(), length, ignore, hits.data());
+  castAgainstCandidates(origin, units, directions.size(), length, ignore, hits.data());
   return hits;
 }
 
@@ -546,11 +601,12 @@ std::vector<RayHit> World::castRayBundles(const std::vector<Vec3>& origins, cons
   std::vector<RayHit> hits(directions.size());
   if (origins.empty()) return hits;
   const std::size_t n = directions.size() / origins.size();
+  const Vec3* units = unitDirections(directions);
   Vec3 lo = origins.front(), hi = origins.front();
-  for (std::size_t k = 0; k < origins.size(); ++k) growRayBounds(origins[k], &directions[k * n], n, length, lo, hi);
+  for (std::size_t k = 0; k < origins.size(); ++k) growRayBounds(origins[k], units + k * n, n, length, lo, hi);
   findRayCandidates(lo, hi, ignore);
   for (std::size_t k = 0; k < origins.size(); ++k)
-    castAgainstCandidates(origins[k], &directions[k * n], n, length, ignore, &hits[k * n]);
+    castAgainstCandidates(origins[k], units + k * n, n, length, ignore, &hits[k * n]);
   return hits;
 }
 

@@ -107,15 +107,15 @@ class World {
   dWorldID odeWorld() const { return world_; }
   dSpaceID space() const { return space_; }
   /// The terrain's static geoms. Not inside space(): each step collides every robot's space with it
-  /// (dSpaceCollide2), so static geoms are never tested against each other (a course of hundreds
-  /// of boxes costs the broadphase almost nothing).
+  /// (collideWithTerrain), so static geoms are never tested against each other (a course of
+  /// hundreds of boxes costs the broadphase almost nothing).
   dSpaceID staticSpace() const { return static_space_; }
   dJointGroupID contactGroup() const { return contacts_; }
 
-  /// Internal (public for the query callbacks): a geom within castRays' box, with its bounding box
-  /// [min x, max x, min y, max y, min z, max z] (ODE's layout): a ray is only tested against the
-  /// geoms whose boxes meet its own segment's.
-  struct RayCandidate {
+  /// Internal (public for the query callbacks): a geom with its bounding box [min x, max x, min y,
+  /// max y, min z, max z] (ODE's layout). castRays tests a ray only against the geoms whose boxes
+  /// meet its segment's; collideWithTerrain a robot only against the static geoms that meet its own.
+  struct BoxedGeom {
     dGeomID geom;
     dReal aabb[6];
   };
@@ -124,6 +124,11 @@ class World {
 
  private:
   void buildTerrain();
+  std::vector<BoxedGeom> terrain_index_;        ///< static_space_'s geoms, in its order (never move)
+  std::vector<BoxedGeom> robot_geoms_;          ///< collideWithTerrain's robot geoms (reused)
+  void indexTerrain();  ///< fills terrain_index_ (after buildTerrain)
+  /// Contacts between a robot and the terrain (see world.cpp for why not dSpaceCollide2).
+  void collideWithTerrain(Robot& r);
   Robot* robotOwning(dGeomID g) const;
   const std::string& materialOf(dGeomID g) const;
 
@@ -135,15 +140,18 @@ class World {
   /// ray cost ~10 % of a sensor-reading Medium step. Makes a World unsafe to query from two threads.
   mutable dGeomID query_ray_ = nullptr;
   mutable dGeomID query_box_ = nullptr;  ///< castRays' bounding box, also in no space
-  mutable std::vector<RayCandidate> ray_candidates_;  ///< castRays' geoms within that box (reused)
+  mutable std::vector<BoxedGeom> ray_candidates_;  ///< castRays' geoms within that box (reused)
   int solver_iterations_ = 0;
   bool exact_solver_ = false;     ///< config_.solver == "exact"
   void updateSolverIterations();  ///< after a robot came, went or changed level
   dGeomID queryRay(double length) const;  ///< query_ray_ with this length
   /// Fills ray_candidates_ with the geoms (not `ignore`'s) whose bounding boxes meet [lo, hi].
   void findRayCandidates(const Vec3& lo, const Vec3& hi, const Robot* ignore) const;
-  /// Casts the n rays `directions` from `origin` against ray_candidates_ only; the hit of directions[i]
-  /// into hits[i] (each a miss at `length` unless something nearer is hit).
+  mutable std::vector<Vec3> ray_units_;  ///< unitDirections' result (reused)
+  /// `directions` normalised into ray_units_ (once per ray for the bounds and the casts).
+  const Vec3* unitDirections(const std::vector<Vec3>& directions) const;
+  /// Casts the n rays of unit `directions` from `origin` against ray_candidates_ only; the hit of
+  /// directions[i] into hits[i] (each a miss at `length` unless something nearer is hit).
   void castAgainstCandidates(const Vec3& origin, const Vec3* directions, std::size_t n, double length,
                              const Robot* ignore, RayHit* hits) const;
   dJointGroupID contacts_ = nullptr;
