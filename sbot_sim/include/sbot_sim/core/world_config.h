@@ -69,7 +69,7 @@ struct WorldConfig {
   std::string solver = "quickstep";
   int solver_iterations = 20;  ///< ODE quickstep iterations (ODE default; see README benchmark)
   /// Raise the iterations to what the robots' levels need (RobotDescription::solver_iterations,
-  /// Detailed: 40) while such a robot is in the world. Off only to study the solver itself.
+  /// Medium: 25, Detailed: 40) while such a robot is in the world. Off only to study the solver itself.
   bool level_iterations = true;
   double solver_sor = 1.3;     ///< ODE quickstep over-relaxation
   /// Opt-in: a turret that has reached its target is welded to the treels (one rigid body) until
