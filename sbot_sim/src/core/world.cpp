@@ -101,7 +101,9 @@ World::World(const WorldConfig& config) : config_(config) {
   dWorldSetContactMaxCorrectingVel(world_, 0.5);
   space_ = dHashSpaceCreate(nullptr);
   static_space_ = dHashSpaceCreate(nullptr);
-  dSpaceSetSublevel(static_space_, 1);  // as the robots' spaces: dSpaceCollide2 iterates the static one
+  // A sublevel above the robots' spaces: ODE's dSpaceCollide2 then walked the static geoms against
+  // a robot space as one geom, the order collideWithTerrain keeps.
+  dSpaceSetSublevel(static_space_, 1);
   contacts_ = dJointGroupCreate(0);
   buildTerrain();
   indexTerrain();

@@ -108,7 +108,8 @@ class World {
   dSpaceID space() const { return space_; }
   /// The terrain's static geoms. Not inside space(): each step collides every robot's space with it
   /// (collideWithTerrain), so static geoms are never tested against each other (a course of
-  /// hundreds of boxes costs the broadphase almost nothing).
+  /// hundreds of boxes costs the broadphase almost nothing). Built once by the constructor, whose
+  /// index of its geoms' boxes would miss a geom added later.
   dSpaceID staticSpace() const { return static_space_; }
   dJointGroupID contactGroup() const { return contacts_; }
 
