@@ -305,19 +305,20 @@ bool boxesMeet(const dReal* a, const dReal* b) {
   return !(a[0] > b[1] || a[1] < b[0] || a[2] > b[3] || a[3] < b[2] || a[4] > b[5] || a[5] < b[4]);
 }
 
-}  // namespace
-
-void World::indexTerrain() {
-  // In static_space_'s own order (ODE's list, newest first), the order its collide2 visits them.
-  terrain_index_.clear();
-  const int n = dSpaceGetNumGeoms(static_space_);
+/// The geoms of `space` with their boxes, in the space's own list order (ODE's, newest first; the
+/// order its collide2 visits them).
+void readBoxedGeoms(dSpaceID space, std::vector<World::BoxedGeom>& out) {
+  const int n = dSpaceGetNumGeoms(space);
+  out.resize(n);
   for (int i = 0; i < n; ++i) {
-    BoxedGeom t;
-    t.geom = dSpaceGetGeom(static_space_, i);
-    dGeomGetAABB(t.geom, t.aabb);
-    terrain_index_.push_back(t);
+    out[i].geom = dSpaceGetGeom(space, i);
+    dGeomGetAABB(out[i].geom, out[i].aabb);
   }
 }
+
+}  // namespace
+
+void World::indexTerrain() { readBoxedGeoms(static_space_, terrain_index_); }
 
 // What dSpaceCollide2(static_space_, robot space) did, pair for pair and in the same order, so runs
 // are unchanged: ODE (the static space a sublevel above the robots') tested every static geom's box
@@ -335,12 +336,7 @@ void World::collideWithTerrain(Robot& r) {
       // As ODE's collide2 does: clears the robot geoms' dirty flags, which decide the order of its
       // list (dGeomMoved puts a moved geom first unless it is still flagged) and so of the contacts.
       dSpaceClean(r.space());
-      const int n = dSpaceGetNumGeoms(r.space());
-      robot_geoms_.resize(n);
-      for (int i = 0; i < n; ++i) {
-        robot_geoms_[i].geom = dSpaceGetGeom(r.space(), i);
-        dGeomGetAABB(robot_geoms_[i].geom, robot_geoms_[i].aabb);
-      }
+      readBoxedGeoms(r.space(), robot_geoms_);
       robot_geoms_read = true;
     }
     for (const BoxedGeom& g : robot_geoms_)
@@ -509,10 +505,12 @@ struct BoxQuery {
 /// An axis-aligned ground plane's box is the half space below it, so the proximity ring's level
 /// rays skip it (most of a flat-ground ring's ray tests, each a dGeomRaySet and a dCollide).
 bool segmentMayMeet(const Vec3& origin, const Vec3& end, const dReal* aabb) {
+  dReal segment[6];
   for (int k = 0; k < 3; ++k) {
-    if (std::max(origin[k], end[k]) < aabb[2 * k] || std::min(origin[k], end[k]) > aabb[2 * k + 1]) return false;
+    segment[2 * k] = std::min(origin[k], end[k]);
+    segment[2 * k + 1] = std::max(origin[k], end[k]);
   }
-  return true;
+  return boxesMeet(segment, aabb);
 }
 
 // Collect the geoms whose bounding boxes meet the query box.
