@@ -13,7 +13,8 @@
 //     turret angle, gripper tip); --index N runs the cell's trial N (its start
 //     perturbation, as in the report; default 0)
 // KIND: gap, step, stepb, slope, slopeb, uphill, downhill, rough, rtm, speed (PARAM: m, m, m, deg,
-// deg, rad, rad, HR in cm, simulated s, setSpeed units of the compatibility check).
+// deg, rad, rad, HR in cm, simulated s, setSpeed units of the compatibility check; ranges in
+// trialKinds()).
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -210,6 +211,47 @@ std::string findHeightmap() {
 #endif
 }
 
+// The kinds of `--trial`, each with its parameter's unit and the range it accepts (a negative gap or
+// a slope past vertical names nothing the experiment can build).
+struct TrialKind {
+  const char* name;
+  const char* unit;
+  double min, max;
+  std::function<Outcome(const std::string& level, double param, int index)> run;
+};
+
+const std::vector<TrialKind>& trialKinds() {
+  static const std::vector<TrialKind> kinds = {
+      {"gap", "gap width, m", 0.0, 0.3, [](const std::string& l, double p, int i) { return v::gapTrial(l, p, i); }},
+      {"step", "step height, m", 0.0, 0.1, [](const std::string& l, double p, int i) { return v::stepTrial(l, p, false, i); }},
+      {"stepb", "step height, m", 0.0, 0.1, [](const std::string& l, double p, int i) { return v::stepTrial(l, p, true, i); }},
+      {"slope", "slope, deg", 0.0, 89.0,
+       [](const std::string& l, double p, int i) { return v::slopeHoldClimbTrial(l, p * M_PI / 180, false, i); }},
+      {"slopeb", "slope, deg", 0.0, 89.0,
+       [](const std::string& l, double p, int i) { return v::slopeHoldClimbTrial(l, p * M_PI / 180, true, i); }},
+      {"uphill", "ramp angle, rad", 0.0, 1.5, [](const std::string& l, double p, int i) { return v::uphillTrial(l, p, i); }},
+      {"downhill", "ramp angle, rad", 0.0, 1.5, [](const std::string& l, double p, int i) { return v::downhillTrial(l, p, i); }},
+      {"rough", "height range HR, cm", 0.0, 100.0,
+       [](const std::string& l, double p, int i) { return v::roughTrial(l, p, i, findHeightmap()); }},
+      {"rtm", "simulated time, s", 0.1, 3600.0, [](const std::string& l, double p, int) { return v::rtmTrial(l, p); }},
+      {"speed", "setSpeed units", -70.0, 70.0,
+       [](const std::string& l, double p, int) { return v::steadySpeedTrial(l, static_cast<int>(std::lround(p))); }},
+  };
+  return kinds;
+}
+
+const TrialKind* findTrialKind(const std::string& name) {
+  for (const TrialKind& k : trialKinds())
+    if (name == k.name) return &k;
+  return nullptr;
+}
+
+std::string trialKindNames() {
+  std::string names;
+  for (const TrialKind& k : trialKinds()) names += (names.empty() ? "" : ", ") + std::string(k.name);
+  return names;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -230,24 +272,16 @@ int main(int argc, char** argv) {
     else if (a == "--index") index = args.count(0, 999);  // with --trial (before it): the cell's trial N
     else if (a == "--trial") {  // --trial KIND LEVEL PARAM: one trial, printed (tuning aid)
       const std::string kind = args.value(), level = args.value();
-      const double p = sbot_tools::numberArg(args.tool(), "--trial " + kind + " " + level, args.value(), -1e6, 1e6);
-      v::setTrace(trace);
-      Outcome r;
-      sbot_tools::requireLevel("sbot_validate", "--trial " + kind + " " + level, level);
-      if (kind == "gap") r = v::gapTrial(level, p, index);
-      else if (kind == "step") r = v::stepTrial(level, p, false, index);
-      else if (kind == "stepb") r = v::stepTrial(level, p, true, index);
-      else if (kind == "slope") r = v::slopeHoldClimbTrial(level, p * M_PI / 180, false, index);
-      else if (kind == "slopeb") r = v::slopeHoldClimbTrial(level, p * M_PI / 180, true, index);
-      else if (kind == "uphill") r = v::uphillTrial(level, p, index);
-      else if (kind == "downhill") r = v::downhillTrial(level, p, index);
-      else if (kind == "rough") r = v::roughTrial(level, p, index, findHeightmap());
-      else if (kind == "rtm") r = v::rtmTrial(level, p);
-      else if (kind == "speed") r = v::steadySpeedTrial(level, static_cast<int>(std::lround(p)));
-      else {
-        std::fprintf(stderr, "sbot_validate: --trial expects gap, step, stepb, slope, slopeb, uphill, downhill, rough, rtm or speed, found '%s'\n", kind.c_str());
+      const TrialKind* k = findTrialKind(kind);
+      if (!k) {
+        std::fprintf(stderr, "sbot_validate: --trial expects %s, found '%s'\n", trialKindNames().c_str(), kind.c_str());
         return 2;
       }
+      sbot_tools::requireLevel("sbot_validate", "--trial " + kind + " " + level, level);
+      const double p = sbot_tools::numberArg(args.tool(), "--trial " + kind + " " + level + " (" + k->unit + ")",
+                                             args.value(), k->min, k->max);
+      v::setTrace(trace);
+      const Outcome r = k->run(level, p, index);
       std::printf("%s %s %g: %s %g %g\n", kind.c_str(), level.c_str(), p, r.label.c_str(), r.value, r.value2);
       return 0;
     }

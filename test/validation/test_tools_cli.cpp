@@ -26,7 +26,10 @@ void expectRefused(const std::string& tool, const std::string& args, const std::
 
 TEST(ToolsCli, NonNumbersAndOutOfRangeValuesAreRefusedByName) {
   expectRefused("sbot_validate", "--out " + testing::TempDir() + "cli --trials abc", "--trials expects a number in [1, 1000], found 'abc'");
-  expectRefused("sbot_validate", "--trial step detailed x", "--trial step detailed expects a number");
+  expectRefused("sbot_validate", "--trial step detailed x", "--trial step detailed (step height, m) expects a number");
+  // Each trial kind checks its parameter against its own unit and range.
+  expectRefused("sbot_validate", "--trial gap medium -0.01", "--trial gap medium (gap width, m) expects a number in [0, 0.3], found '-0.01'");
+  expectRefused("sbot_validate", "--trial uphill fast 2", "--trial uphill fast (ramp angle, rad) expects a number in [0, 1.5], found '2'");
   expectRefused("sbot_validate", "--trial bogus detailed 1", "found 'bogus'");
   expectRefused("sbot_validate", "--index -1 --trial gap fast 0.03", "--index expects a number in [0, 999], found '-1'");
   expectRefused("switching_experiment", "--runs 0", "--runs expects a number in [1, 1000], found '0'");
