@@ -50,6 +50,17 @@ def path_steps(path):
     return steps
 
 
+def unshared(node):
+    """A copy in which no two places share a list or mapping. YAML aliases (`*turret_api`, the
+    turret COM the levels share) load as one Python object, so setting one level's value would set
+    every level's; a PATH names one place in the table."""
+    if isinstance(node, dict):
+        return {k: unshared(v) for k, v in node.items()}
+    if isinstance(node, list):
+        return [unshared(v) for v in node]
+    return node
+
+
 def set_value(table, path, value):
     """Replace an existing entry; a path that names nothing in the table is an error (typos)."""
     node = table
@@ -132,12 +143,12 @@ def main():
         fixed = [parse_assignment(s, False) for s in a.set]
         grid = [parse_assignment(g, True) for g in a.grid]
         with open(TABLE, encoding="utf-8") as fh:
-            base = yaml.safe_load(fh)
+            base = unshared(yaml.safe_load(fh))
         for path, (value,) in fixed:
             set_value(base, path, value)
         # Validate every grid path once before running anything.
         for path, values in grid:
-            set_value(yaml.safe_load(yaml.safe_dump(base)), path, values[0])
+            set_value(unshared(base), path, values[0])
     except (OSError, ValueError, yaml.YAMLError) as e:
         print("sweep_description: %s" % e, file=sys.stderr)
         return 2
@@ -146,7 +157,7 @@ def main():
     combos = list(itertools.product(*[values for _, values in grid])) or [()]
     print("%d variant(s); sections %s, %d trial(s) per cell; files in %s" % (len(combos), a.only, a.trials, root))
     for n, combo in enumerate(combos):
-        table = yaml.safe_load(yaml.safe_dump(base))
+        table = unshared(base)
         label = ", ".join("%s=%s" % (path, v) for (path, _), v in zip(grid, combo)) or "table as set"
         for (path, _), v in zip(grid, combo):
             set_value(table, path, v)

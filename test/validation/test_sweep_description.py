@@ -29,6 +29,12 @@ class SweepDescription(unittest.TestCase):
                 urdf = fh.read()
             turret = urdf[urdf.index('<link name="turret">'):]
             self.assertRegex(turret[:400], r'<origin xyz="%s 0 ' % re.escape(x))
+            # Medium shares the table's calibrated turret COM with Detailed (a YAML alias): the
+            # path names Detailed's only.
+            with open(os.path.join(keep, "variant_%03d" % n, "urdf", "medium.urdf"), encoding="utf-8") as fh:
+                medium = fh.read()
+            medium_turret = medium[medium.index('<link name="turret">'):]
+            self.assertRegex(medium_turret[:400], r'<origin xyz="0.03 0 ')
             self.assertTrue(os.path.exists(os.path.join(keep, "variant_%03d" % n, "report", "report.md")))
 
     def test_a_misspelt_path_is_refused_by_name(self):

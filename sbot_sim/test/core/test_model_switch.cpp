@@ -95,8 +95,10 @@ TEST(ModelSwitch, SwitchingToTheSameLevelDoesNotDisturbTheTrajectory) {
 TEST(ModelSwitch, SwitchedRunFollowsTheUnswitchedTrajectory) {
   // Through every full-size level: straight ahead the levels agree within 2 cm after 0.8 m; on a
   // curve their turning differs (seed 4.3: "the detailed model is not very accurate in making
-  // right angle turns"), still within 12 cm (9.0 cm measured before the Detailed turret's COM was
-  // calibrated 1 cm further back than Medium's on the hardware rows, 10.2 cm since).
+  // right angle turns": unswitched at (50, 35) for 6 s Simple, Basic and Medium turn 173-176-164
+  // deg, Detailed 92), still within 15 cm. Measured: 9.0 cm before the Detailed turret's COM was
+  // calibrated 1 cm further back on the hardware rows, 10.2 cm after, 13.1 cm since Basic and
+  // Medium share that COM (2026-11-27; Medium then turned 177 deg, now 164).
   const std::vector<std::string> cycle{"medium", "detailed", "medium", "basic", "simple", "basic"};
   const auto ref = driveSwitching(50, 50, {});
   const auto sw = driveSwitching(50, 50, cycle);
@@ -111,7 +113,7 @@ TEST(ModelSwitch, SwitchedRunFollowsTheUnswitchedTrajectory) {
   std::printf("curve, switched vs unswitched after 6 s: %.4f m, heading %.2f deg\n", err_c,
               test::wrapAngle(sw_c.first.yaw() - ref_c.first.yaw()) * 180 / M_PI);
   EXPECT_LT(sw_c.second, 0.003);
-  EXPECT_LT(err_c, 0.12);
+  EXPECT_LT(err_c, 0.15);
 }
 
 TEST(ModelSwitch, LevelsRoundTrip) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include <cmath>
+#include <map>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -273,17 +274,20 @@ double headingChange(const std::string& level, const std::string& solver, int un
 }
 
 TEST(Treels, WeldedTurretsKeepTheHeadingUnderQuickstep) {
-  // Quickstep does not converge on the turret hinged 4 cm off its centre of mass: standing or at
-  // 60 units, Basic and Medium turn 5-11 deg in 10 s. Welded while idle (opt-in WorldConfig::
-  // lock_idle_turret) they turn 0.4-2.7 deg (README, "Yaw drift and the turret weld").
+  // Quickstep does not converge on the turret hinged 3 cm off its centre of mass: standing or at
+  // 60 units, Basic and Medium turn 5-7 deg in 10 s. Welded while idle (opt-in WorldConfig::
+  // lock_idle_turret) they turn 0.0-1.4 deg (README, "Yaw drift and the turret weld").
   for (const std::string level : {"simple", "basic", "medium", "detailed"}) {
     EXPECT_LT(std::abs(headingChange(level, "quickstep", 0, true)), 2.0) << level << " standing";
-    // Detailed hardly drifts on its hinge (-1.9 deg); welded it turns +4.1 deg driving (3.6 before
-    // the treels' creep). The weld is for Basic and Medium (now +1.7 and +0.7 deg).
+    // Detailed hardly drifts on its hinge (-0.9 deg driving); welded it turns +0.7 deg (+4.1 before
+    // 2026-11-27). The weld is for Basic and Medium (+0.7 and -0.8 deg driving).
     const double driving_bound = level == "detailed" ? 5.0 : 4.0;
     EXPECT_LT(std::abs(headingChange(level, "quickstep", 60, true)), driving_bound) << level << " driving";
   }
-  EXPECT_GT(std::abs(headingChange("medium", "quickstep", 60)), 5.0) << "the drift the weld removes";
+  // The drift the weld removes (2026-11-27: Medium -5.0 deg driving, Basic -6.4; with the turret's
+  // centre of mass 4 cm off its axis, before then, -6.7 and -7.5).
+  EXPECT_GT(std::abs(headingChange("medium", "quickstep", 60)), 3.0) << "the drift the weld removes";
+  EXPECT_GT(std::abs(headingChange("basic", "quickstep", 60)), 3.0) << "the drift the weld removes";
 }
 
 TEST(TreelsExactSolver, SymmetricCommandsDriveStraight) {
@@ -336,24 +340,44 @@ TEST(DriveWheelLoad, SimpleRestsHalfOnItsCastersUnderQuickstep) {
   EXPECT_GT(driveWheelShare(x, rx, 1.0), 0.95) << "exact solver";
 }
 
-TEST(DriveWheelLoad, BasicLeansOnItsFrontCasterAsItsCentreOfMassSays) {
-  // Two wheels on the axle (x = 0) and the front caster at x = 0.04 carry the weight; with the
-  // centre of mass at x_c between them, statics give the wheels 1 - x_c / 0.04 of it.
-  World w(flatWorld());
-  Robot& r = w.addRobot(loadLevel("basic"), {0, 0, 0}, "sbot_0");
-  runFor(w, 1.0);
+// The share of a Basic robot's weight its wheels carry by statics, as it stands now: the two
+// spherical wheels and the front caster carry it, so with the centre of mass between the wheels'
+// and the caster's ground contacts (x_w, x_c, x_f) the wheels take (x_f - x_c) / (x_f - x_w).
+// Spheres on flat ground touch it straight below their centres, so the x are taken horizontally
+// in the world, along the robot's heading (the robot leans onto its caster, 2 mm lower than the
+// wheels' plane, and under quickstep its wheel hinges sag).
+double basicWheelShareByStatics(const Robot& r) {
+  const Vec3 heading = r.basePose().orientation * Vec3::UnitX();
+  const auto along = [&](const Vec3& p) { return p.head<2>().dot(heading.head<2>().normalized()); };
   double mass = 0, moment = 0;
-  const Pose base = r.basePose();
   for (dBodyID b : r.bodies()) {
     dMass m;
     dBodyGetMass(b, &m);
     const dReal* p = dBodyGetPosition(b);
     mass += m.mass;
-    moment += m.mass * base.inverse().transform(Vec3(p[0], p[1], p[2])).x();
+    moment += m.mass * along(Vec3(p[0], p[1], p[2]));
   }
   const double x_c = moment / mass;
-  ASSERT_GT(x_c, 0.01) << "Basic's offset centre of mass";
-  EXPECT_NEAR(driveWheelShare(w, r, 1.0), 1.0 - x_c / 0.04, 0.05);
+  const double x_w = 0.5 * (along(r.linkPose("left_wheel").position) + along(r.linkPose("right_wheel").position));
+  const double x_f = along(r.linkPose("caster_front").position);
+  EXPECT_GT(x_c - along(r.basePose().position), 0.01) << "Basic's offset centre of mass";
+  return (x_f - x_c) / (x_f - x_w);
+}
+
+TEST(DriveWheelLoad, BasicLeansOnItsFrontCasterAsItsCentreOfMassSays) {
+  // Converged (exact solver) the wheels carry what statics say (0.530 against 0.530). Quickstep at
+  // 20 iterations leaves the wheel hinges sagging and the casters take ~5 % of the weight more
+  // (0.506 against 0.556; the known flaw SimpleRestsHalfOnItsCastersUnderQuickstep pins).
+  const std::map<std::string, double> tolerance{{"exact", 0.01}, {"quickstep", 0.07}};
+  for (const auto& [solver, tol] : tolerance) {
+    WorldConfig c = flatWorld();
+    c.solver = solver;
+    World w(c);
+    Robot& r = w.addRobot(loadLevel("basic"), {0, 0, 0}, "sbot_0");
+    runFor(w, 1.0);
+    const double statics = basicWheelShareByStatics(r);
+    EXPECT_NEAR(driveWheelShare(w, r, 1.0), statics, tol) << solver;
+  }
 }
 
 TEST(DriveWheelLoad, NothingWhileAirborne) {
