@@ -349,9 +349,14 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial) {
     load_ratio.push_back(r.driveWheelLoad() / weight);
     positions.push_back(r.basePose().position);
     if (track_ratio.size() > window) { track_ratio.pop_front(); load_ratio.pop_front(); positions.pop_front(); }
+    // Toppled (over backwards): over, or tilted more than 75 deg off the normal of the surface
+    // under its base, ramp or floor (a robot on the ramp leans back at most its own tipping angle;
+    // one with its rear on the floor at the foot and its front up the face stands at 56-62 deg).
+    // Until 2026-11-27 the floor counted only from 100 deg off vertical, and a Medium that reared
+    // onto its tail at the foot of the 1.0 rad ramp (86 deg) and fell on its side was "slide back".
     const Vec3 up = upOf(r);
-    if (angleBetween(up, Vec3::UnitZ()) > 100 * M_PI / 180 ||
-        (r.basePose().position.x() > 0 && angleBetween(up, normal) > 75 * M_PI / 180)) {
+    const Vec3& under = r.basePose().position.x() > 0 ? normal : Vec3::UnitZ();
+    if (angleBetween(up, Vec3::UnitZ()) > 100 * M_PI / 180 || angleBetween(up, under) > 75 * M_PI / 180) {
       o.label = "topple";
       return true;
     }

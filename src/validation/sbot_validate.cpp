@@ -723,7 +723,7 @@ int main(int argc, char** argv) {
     });
     md << "## Table 4.6 - uphill slope per level at 2.8 cm/s (modal of " << o.trials << ")\n\n"
        << "The robot starts 12 cm before the foot of a ramp. climb: 25 cm up the slope; topple: over "
-          "backwards; slide back: got > 3 cm up and lost > 3 cm again; c/c: at the foot (< 5 cm up) with its "
+          "backwards (tilted > 75 deg off the normal of the ramp or floor under its base); slide back: got > 3 cm up and lost > 3 cm again; c/c: at the foot (< 5 cm up) with its "
           "heading changed > 20 deg, still travelling (>= 25 % of the commanded distance over the last 2 s); "
           "slipping: short of 25 cm with its tracks turning (encoders >= 50 % of the command over the last 2 s) "
           "while the driven wheels carry >= 25 % of the weight; stuck: short of 25 cm otherwise (tracks stalled, "
