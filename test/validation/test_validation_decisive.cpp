@@ -123,3 +123,15 @@ TEST(ValidationDownhill, DetailedManagesAGentleRampAndTopplesForwardOnSteeperOne
   EXPECT_EQ(r[1].label, "topple") << "0.5 rad";
   EXPECT_EQ(r[2].label, "topple") << "0.8 rad";
 }
+
+TEST(ValidationLabels, ARobotThatRearsOverAtTheRampsFootHasToppled) {
+  // Table 4.6: a Medium at 0.9 and 1.0 rad gets its front up the face with its rear spheres wedged
+  // in the ramp's foot, rears onto its tail (86-90 deg) and falls on its side. Until 2026-11-27 the
+  // rule counted a robot on the floor as toppled only from 100 deg off vertical, and these trials
+  // (both "slide back" then) looked like the seed's slide back.
+  const std::vector<std::pair<double, int>> trials{{1.0, 0}, {0.9, 1}};
+  const auto res = v::runParallel(static_cast<int>(trials.size()), 2,
+                                  [&](int i) { return v::uphillTrial("medium", trials[i].first, trials[i].second); });
+  for (std::size_t i = 0; i < trials.size(); ++i)
+    EXPECT_EQ(res[i].label, "topple") << trials[i].first << " rad, trial " << trials[i].second;
+}
