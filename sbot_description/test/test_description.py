@@ -351,6 +351,31 @@ class TestDescription(unittest.TestCase):
                 errs = value_errors(u, sc, self.par[level], level)
                 self.assertTrue(errs, "mutation %s=%r not detected" % (".".join(path), value))
 
+    def test_a_table_that_cannot_describe_a_body_is_refused_by_name(self):
+        """A mass, radius or size that is not > 0, or a NaN anywhere, stops the generator with the
+        field's path (as resolved: Detailed inherits Medium's wheels)."""
+        cases = [("medium", ["turret", "mass_kg"], -1.0, "levels.medium.turret.mass_kg: expected a number > 0"),
+                 ("medium", ["wheels", "center", "radius_m"], 0.0,
+                  "levels.medium.wheels.center.radius_m: expected a number > 0"),
+                 ("simple", ["chassis", "com_m"], [0.0, float("nan"), 0.0],
+                  "levels.simple.chassis.com_m[1]: expected a finite number")]
+        for level, path, value, message in cases:
+            table = copy.deepcopy(TABLE)
+            node = table["levels"][level]
+            for k in path[:-1]:
+                node = node[k]
+            node[path[-1]] = value
+            with tempfile.TemporaryDirectory() as tmp:
+                tpath = os.path.join(tmp, "table.yaml")
+                with open(tpath, "w") as fh:
+                    yaml.safe_dump(table, fh)
+                r = subprocess.run(["/usr/bin/python3", os.path.join(PKG, "scripts", "generate_urdf.py"), "--out",
+                                    os.path.join(tmp, "out"), "--quiet", "--params", tpath],
+                                   capture_output=True, text=True)
+                self.assertNotEqual(r.returncode, 0, ".".join(path))
+                self.assertIn(message, r.stderr)
+                self.assertIn(tpath, r.stderr)
+
     def test_d_total_mass_and_fast_scaling(self):
         for lv in LEVELS:
             total = sum(self.urdf[lv].mass(l) for l in self.urdf[lv].links)
