@@ -250,6 +250,19 @@ def value_errors(u, sc, p, level):
     return err
 
 
+def write_changed_table(tmp, level, path, value):
+    """The parameter table with levels.<level>.<path> set to value, written into tmp; its path."""
+    table = copy.deepcopy(TABLE)
+    node = table["levels"][level]
+    for k in path[:-1]:
+        node = node[k]
+    node[path[-1]] = value
+    tpath = os.path.join(tmp, "table.yaml")
+    with open(tpath, "w") as fh:
+        yaml.safe_dump(table, fh)
+    return tpath
+
+
 def generate_to(tmp, table_path=None):
     args = ["--out", tmp, "--quiet"]
     if table_path:
@@ -335,15 +348,8 @@ class TestDescription(unittest.TestCase):
                      ("medium", ["wheels", "front_rear", "y_m"], 0.03),
                      ("simple", ["treels", "max_torque_Nm"], 0.3)]
         for level, path, value in mutations:
-            table = copy.deepcopy(TABLE)
-            node = table["levels"][level]
-            for k in path[:-1]:
-                node = node[k]
-            node[path[-1]] = value
             with tempfile.TemporaryDirectory() as tmp:
-                tpath = os.path.join(tmp, "table.yaml")
-                with open(tpath, "w") as fh:
-                    yaml.safe_dump(table, fh)
+                tpath = write_changed_table(tmp, level, path, value)
                 out = os.path.join(tmp, "out")
                 generate_to(out, tpath)
                 u = Urdf(os.path.join(out, level + ".urdf"))
@@ -360,15 +366,8 @@ class TestDescription(unittest.TestCase):
                  ("simple", ["chassis", "com_m"], [0.0, float("nan"), 0.0],
                   "levels.simple.chassis.com_m[1]: expected a finite number")]
         for level, path, value, message in cases:
-            table = copy.deepcopy(TABLE)
-            node = table["levels"][level]
-            for k in path[:-1]:
-                node = node[k]
-            node[path[-1]] = value
             with tempfile.TemporaryDirectory() as tmp:
-                tpath = os.path.join(tmp, "table.yaml")
-                with open(tpath, "w") as fh:
-                    yaml.safe_dump(table, fh)
+                tpath = write_changed_table(tmp, level, path, value)
                 r = subprocess.run(["/usr/bin/python3", os.path.join(PKG, "scripts", "generate_urdf.py"), "--out",
                                     os.path.join(tmp, "out"), "--quiet", "--params", tpath],
                                    capture_output=True, text=True)
