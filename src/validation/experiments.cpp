@@ -398,6 +398,7 @@ Outcome downhillTrial(const std::string& level, double angle_rad, int trial) {
   Robot& r = spawn(w, d, {-0.10 * s + j.uniform(-0.01, 0.01) * s, j.uniform(-0.01, 0.01) * s, j.uniform(-0.05, 0.05)});
   r.setSpeed(0, 0);
   w.stepN(static_cast<int>(0.3 / c.step));
+  const double h0 = headingOf(r);
   r.setSpeed(kSlowUnits, kSlowUnits);
   Outcome o{"stuck"};
   const double foot = L * std::cos(angle_rad), goal = foot + 0.10 * s;
@@ -419,6 +420,10 @@ Outcome downhillTrial(const std::string& level, double angle_rad, int trial) {
     return false;
   });
   o.value = r.basePose().position.x();
+  o.value2 = std::fabs(std::remainder(headingOf(r) - h0, 2 * M_PI));
+  // Short of the goal, upright, but turned off its course (e.g. slewed across the ramp at the
+  // plateau's edge and driving along it): that robot changed course; it is not stuck.
+  if (o.label == "stuck" && o.value2 > 0.35) o.label = "c/c";
   return o;
 }
 

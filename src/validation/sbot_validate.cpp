@@ -755,8 +755,9 @@ int main(int argc, char** argv) {
     md << "### Downhill (4.2.4: all models manage up to about 0.5 rad, steeper slopes topple forward)\n\n"
        << "The robot starts 10 cm before the edge of a plateau and drives down a 40 cm ramp at 2.8 cm/s. "
           "pass: 10 cm beyond the ramp's foot, upright (< 17 deg); topple: over (> 100 deg off vertical), or "
-          "tilted > 45 deg off the normal of the surface under its base (onto its nose or gripper). Not tallied: the "
-          "seed gives no table.\n\n"
+          "tilted > 45 deg off the normal of the surface under its base (onto its nose or gripper); c/c: short of "
+          "the goal, upright, its heading turned > 20 deg (slewed across the ramp); stuck: otherwise. Not tallied: "
+          "the seed gives no table.\n\n"
        << "| angle | seed | fast | simple | medium | detailed |\n|---|---|---|---|---|---|\n";
     for (std::size_t a = 0; a < down.size(); ++a) {
       md << "| " << fmt(down[a]) << " rad | " << (down[a] <= 0.5 ? "pass" : "topple (forward)");
