@@ -178,9 +178,10 @@ class Modules(unittest.TestCase):
         self.assertEqual(info.wait(1)[0].width, 640)
 
     def test_slope_flat(self):
-        # On flat ground. The Medium model rests 3-4 deg nose down under quickstep at 20 iterations
-        # (docs/validation/report.md, "Model facts": pitch 3.4 deg; 0.5 deg at 200 iterations), so
-        # its reading may be -4 (a bound of 3 failed a fresh-clone run on 2026-11-25); the Simple model rests level.
+        # On flat ground. The Medium model rests nose down under quickstep (docs/validation/report.md,
+        # "Model facts": pitch 1.3 deg at its 25 iterations since 2026-11-27; 3.4 deg at 20 with Table
+        # 2.3's turret COM, when its reading reached -4 and a bound of 3 failed a fresh-clone run on
+        # 2026-11-25); the Simple model rests level.
         s = rospy.wait_for_message('/sbot_0/slope', Slope, 20)
         self.assertLessEqual(abs(s.pitch), 5)
         self.assertLessEqual(abs(s.roll), 3)
