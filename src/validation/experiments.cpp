@@ -59,6 +59,10 @@ double headingOf(const Robot& r) {
   const Vec3 f = r.basePose().orientation * Vec3::UnitX();
   return std::atan2(f.y(), f.x());
 }
+/// How far the robot's heading has turned from `h0` [rad, 0..pi].
+double headingChangeSince(const Robot& r, double h0) { return std::fabs(std::remainder(headingOf(r) - h0, 2 * M_PI)); }
+/// Tables 4.6 and 4.2.4: a robot whose heading turned more than this has changed course ("c/c").
+constexpr double kCourseChange = 0.35;  // [rad], 20 deg
 
 /// Steps between two calls of runFor's check: ~0.05 s (every step for Fast's 0.1 s).
 int checkEvery(const World& w) { return std::max(1, static_cast<int>(std::lround(0.05 / w.config().step))); }
@@ -355,7 +359,7 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial) {
     // Until 2026-11-27 the floor counted only from 100 deg off vertical, and a Medium that reared
     // onto its tail at the foot of the 1.0 rad ramp (86 deg) and fell on its side was "slide back".
     const Vec3 up = upOf(r);
-    const Vec3& under = r.basePose().position.x() > 0 ? normal : Vec3::UnitZ();
+    const Vec3 under = r.basePose().position.x() > 0 ? normal : Vec3(Vec3::UnitZ());
     if (angleBetween(up, Vec3::UnitZ()) > 100 * M_PI / 180 || angleBetween(up, under) > 75 * M_PI / 180) {
       o.label = "topple";
       return true;
@@ -364,7 +368,7 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial) {
     if (along() > 0.25 * s) { o.label = "climb"; return true; }
     return false;
   });
-  const double dh = std::fabs(std::remainder(headingOf(r) - h0, 2 * M_PI));
+  const double dh = headingChangeSince(r, h0);
   o.value = best;
   o.value2 = dh;
   if (o.label == "stuck") {
@@ -378,7 +382,7 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial) {
     // casters) do not slip: that robot is stuck.
     const bool travelling = travel >= 0.25 * kSlowSpeed * 2.0;
     if (best > 0.03 * s && along() < best - 0.03 * s) o.label = "slide back";
-    else if (best <= 0.05 * s && dh > 0.35 && travelling) o.label = "c/c";
+    else if (best <= 0.05 * s && dh > kCourseChange && travelling) o.label = "c/c";
     else if (turning >= 0.5 && load >= 0.25) o.label = "slipping";
   }
   return o;
@@ -420,10 +424,10 @@ Outcome downhillTrial(const std::string& level, double angle_rad, int trial) {
     return false;
   });
   o.value = r.basePose().position.x();
-  o.value2 = std::fabs(std::remainder(headingOf(r) - h0, 2 * M_PI));
+  o.value2 = headingChangeSince(r, h0);
   // Short of the goal, upright, but turned off its course (e.g. slewed across the ramp at the
   // plateau's edge and driving along it): that robot changed course; it is not stuck.
-  if (o.label == "stuck" && o.value2 > 0.35) o.label = "c/c";
+  if (o.label == "stuck" && o.value2 > kCourseChange) o.label = "c/c";
   return o;
 }
 
@@ -464,7 +468,7 @@ Outcome roughTrial(const std::string& level, double hr_cm, int trial, const std:
   const Vec3 p1 = r.basePose().position;
   Outcome o{"ok"};
   o.value = (p1 - p0).dot(Vec3(std::cos(h0), std::sin(h0), 0));
-  o.value2 = std::fabs(std::remainder(headingOf(r) - h0, 2 * M_PI));
+  o.value2 = headingChangeSince(r, h0);
   return o;
 }
 
