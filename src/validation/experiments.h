@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "step_statics.h"
+
 namespace sbot {
 struct WorldConfig;
 namespace validation {
@@ -103,6 +105,13 @@ Outcome steadySpeedTrial(const std::string& level, int units);
 /// Mass, bodies, centre of mass (base frame and height) and rest attitude on flat ground after 2 s.
 std::string restFacts(const std::string& level);
 
+/// `level`'s side view for the step statics (step_statics.h): the left track's centre and front
+/// wheels from the description, the centre of mass measured at rest on flat ground (as restFacts).
+SideView sideView(const std::string& level);
+
+/// Mass [kg] of `level`'s turret link and of the whole robot (what moving the turret's COM moves).
+double turretMassShare(const std::string& level);
+
 /// Static tipping angle [deg]: the robot stands (setSpeed(0,0), servos holding) while gravity tilts
 /// by 1 deg/s, rear uphill (`backward`: it tips over its front) or front uphill; the slope at which
 /// it tilts past 45 deg off the slope's normal (value; 90 = did not tip), and the slope at which it
@@ -116,8 +125,9 @@ std::vector<Outcome> runParallel(int n, int processes, const std::function<Outco
 
 /// Whether a cell whose seed (or hardware) value is `expected` accepts our label `ours`. `expected`
 /// may list alternatives separated by '|' (mixed seed cells such as "pass (50%) stuck (50%)"); a
-/// seed "stuck" accepts our "fall inside" (fell in the gap), a "fail" our "topple" (toppling off a
-/// step fails it).
+/// seed "stuck" accepts our "fall inside" (fell in the gap) and a hardware "fall inside" our "stuck"
+/// (Table 4.2's caption: "falls inside for failing to overcome it"), a "fail" our "topple"
+/// (toppling off a step fails it).
 bool accepts(const std::string& expected, const std::string& ours);
 
 /// The modal label of a set of outcomes (ties: the first label reaching the count, in input order).
