@@ -708,6 +708,9 @@ SideView sideView(const std::string& level) {
     if (std::abs(o.x()) < std::abs(jointNamed(d, centre).origin.position.x())) centre = name;
     if (o.x() > jointNamed(d, front).origin.position.x()) front = name;
   }
+  if (front == centre)
+    throw ConfigError(d.sidecar_path, "treels.left_joints",
+                      "the step statics need a front wheel ahead of the centre wheel, found only '" + centre + "'");
   for (const auto& name : {centre, front})
     if (jointNamed(d, name).parent != d.root_link)
       throw ConfigError(d.urdf_path, name, "a wheel hinge on '" + jointNamed(d, name).parent + "', expected one on " + d.root_link);

@@ -107,6 +107,7 @@ std::string restFacts(const std::string& level);
 
 /// `level`'s side view for the step statics (step_statics.h): the left track's centre and front
 /// wheels from the description, the centre of mass measured at rest on flat ground (as restFacts).
+/// Throws ConfigError for a level without a front wheel ahead of its centre wheel (Fast, Simple, Basic).
 SideView sideView(const std::string& level);
 
 /// Mass [kg] of `level`'s turret link and of the whole robot (what moving the turret's COM moves).

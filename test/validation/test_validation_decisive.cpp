@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "experiments.h"
+#include "sbot_sim/core/errors.h"
 #include "mismatch_reasons.h"
 
 namespace v = sbot::validation;
@@ -176,4 +177,14 @@ TEST(StepStatics, PredictsWhereTheDetailedModelTopplesReversingOntoAStep) {
   const auto r = v::runParallel(2, 2, [&](int i) { return v::stepTrial("detailed", tip + (i == 0 ? -0.001 : 0.003), true, 0); });
   EXPECT_EQ(r[0].label, "pass") << "reversing onto " << (tip - 0.001) * 1000 << " mm";
   EXPECT_EQ(r[1].label, "topple") << "reversing onto " << (tip + 0.003) * 1000 << " mm";
+}
+
+TEST(StepStatics, RefusesALevelWithoutFrontWheels) {
+  // Simple drives on two centre wheels and casters: there is no front wheel to meet the step's face.
+  try {
+    v::sideView("simple");
+    FAIL() << "expected a ConfigError";
+  } catch (const sbot::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("front wheel"), std::string::npos) << e.what();
+  }
 }
