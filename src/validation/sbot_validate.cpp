@@ -139,10 +139,11 @@ std::string backwardStepStatics() {
         "face its support moves to the corner, behind its axle, and the robot tips onto its gripper if its centre "
         "of mass lies ahead of that corner. Ours: the centre of mass "
      << cm(s.com_x) << " cm ahead of the centre axle and " << cm(s.com_z) << " cm above it (measured at rest); it tips "
-        "statically from a " << fmt(v::cornerTipHeight(s) * 1000, 1) << " mm step (the trials above; they pass up to "
-        "about 1 mm more). The hardware's limit (15 mm passes, 16 mm fails) takes the centre of mass at most "
-     << cm(needed.com_x) << " cm ahead of the centre axle at the same height: the turret's own COM " << cm(turret_shift)
-     << " cm further back than ours (Table 2.3: 4 +- 1 cm ahead of the turret axis). With it the rigid static tip "
+        "statically from a " << fmt(v::cornerTipHeight(s) * 1000, 1) << " mm step (the trials follow the statics within about 1 mm; "
+        "the gtest StepStatics.PredictsWhere... checks it). The hardware's limit (15 mm passes, 16 mm fails) takes the centre of mass at most "
+     << cm(needed.com_x) << " cm ahead of the centre axle at the same height: the turret's own COM "
+     << cm(std::abs(turret_shift)) << " cm further " << (turret_shift >= 0 ? "back" : "forward")
+     << " than ours (Table 2.3: 4 +- 1 cm ahead of the turret axis). With it the rigid static tip "
         "facing downhill rises from " << deg(v::frontTipSlope(s)) << " to " << deg(v::frontTipSlope(needed))
      << " deg (hardware: \"difficult\" at 20 deg and toppling at 30 deg rear uphill; src/validation/README.md, "
         "*Step statics*, has the trials with such a centre of mass).\n\n";
