@@ -11,13 +11,17 @@ source tree is never touched. One line per variant: the cells matched per table 
 cells.
 
 PATH is a dotted path into the table, with [i] for list elements, e.g.
-  --grid 'levels.medium.turret.com_m[0]=0.030,0.035,0.040'   (Detailed inherits Medium's turret)
-VALUE is YAML: 0.03, [0.03, 0, 0.011], true, text.
+  --grid 'levels.detailed.turret.com_m[0]=0.030,0.035,0.040'
+  --grid 'levels.medium.treels.creep_stiffness=3.0,5.6'       (Detailed inherits Medium's treels)
+VALUE is YAML: 0.03, [0.03, 0, 0.011], true, text. A path names one place: the table is copied
+without its YAML aliases first. A variant whose generated files equal the table's own is named and
+not run (e.g. a path under `shared:`, which the levels copy when the table loads).
 
 Runs $SBOT_VALIDATE if set, else this tree's build/ws/devel/lib/swarmbot3d/sbot_validate, else
 `rosrun swarmbot3d sbot_validate`. Needs /usr/bin/python3 with PyYAML.
 """
 import argparse
+import filecmp
 import itertools
 import os
 import re
@@ -35,6 +39,13 @@ TABLE = os.path.join(DESCRIPTION, "config", "sbot_parameters.yaml")
 GENERATOR = os.path.join(DESCRIPTION, "scripts", "generate_urdf.py")
 
 _STEP = re.compile(r"([^.\[\]]+)|\[(\d+)\]")
+
+# A variant whose URDFs and sidecars come out byte for byte as the table's own. Typically a path
+# under `shared:`: the levels read those entries through YAML aliases (`*name`) and merge keys
+# (`<<: *name`) when the table loads, so the copies the levels hold do not follow a later change.
+NO_CHANGE = ("changes nothing in the generated descriptions, not run (an entry under 'shared:' reaches "
+             "the levels only through YAML aliases and merge keys when the table loads: set the level's own "
+             "path, e.g. levels.medium.treels.creep_stiffness, which Detailed inherits)")
 
 
 def path_steps(path):
@@ -109,7 +120,8 @@ def validate_command():
     return [local] if os.access(local, os.X_OK) else ["rosrun", "swarmbot3d", "sbot_validate"]
 
 
-def run_variant(table, only, trials, workdir):
+def generate(table, workdir):
+    """The URDFs and sidecars of `table` in workdir/urdf; an error message, or None."""
     os.makedirs(os.path.join(workdir, "urdf"))
     shutil.copytree(os.path.join(DESCRIPTION, "config"), os.path.join(workdir, "config"))
     params = os.path.join(workdir, "params.yaml")
@@ -118,7 +130,26 @@ def run_variant(table, only, trials, workdir):
     gen = subprocess.run(["/usr/bin/python3", GENERATOR, "--out", os.path.join(workdir, "urdf"), "--params", params,
                           "--quiet"], capture_output=True, text=True)
     if gen.returncode != 0:
-        return "generator failed: " + (gen.stderr.strip().splitlines() or ["?"])[-1], []
+        return "generator failed: " + (gen.stderr.strip().splitlines() or ["?"])[-1]
+    return None
+
+
+def same_files(dir_a, dir_b):
+    """Whether two directories hold the same files with the same bytes."""
+    names = sorted(os.listdir(dir_a))
+    if names != sorted(os.listdir(dir_b)):
+        return False
+    return all(filecmp.cmp(os.path.join(dir_a, n), os.path.join(dir_b, n), shallow=False) for n in names)
+
+
+def run_variant(table, only, trials, workdir, baseline_urdf=None):
+    """Generate and validate one variant: (tally, mismatched rows). A variant whose generated files
+    equal `baseline_urdf`'s changes nothing the simulator reads and is not run."""
+    error = generate(table, workdir)
+    if error:
+        return error, []
+    if baseline_urdf and same_files(os.path.join(workdir, "urdf"), baseline_urdf):
+        return NO_CHANGE, []
     env = dict(os.environ, SBOT_DESCRIPTION_DIR=workdir)
     out = os.path.join(workdir, "report")
     val = subprocess.run(validate_command() + ["--out", out, "--only", only, "--trials", str(trials)], env=env,
@@ -154,6 +185,15 @@ def main():
         return 2
     root = a.keep or tempfile.mkdtemp(prefix="sbot_sweep_")
     os.makedirs(root, exist_ok=True)
+    # The table's own descriptions, to tell a variant that changes nothing (see NO_CHANGE). A variant
+    # that sets the table's own values (a grid's reference point) is run as any other.
+    baseline = os.path.join(root, "baseline")
+    with open(TABLE, encoding="utf-8") as fh:
+        own = unshared(yaml.safe_load(fh))
+    error = generate(own, baseline)
+    if error:
+        print("sweep_description: the table itself: %s" % error, file=sys.stderr)
+        return 2
     combos = list(itertools.product(*[values for _, values in grid])) or [()]
     print("%d variant(s); sections %s, %d trial(s) per cell; files in %s" % (len(combos), a.only, a.trials, root))
     for n, combo in enumerate(combos):
@@ -161,7 +201,8 @@ def main():
         label = ", ".join("%s=%s" % (path, v) for (path, _), v in zip(grid, combo)) or "table as set"
         for (path, _), v in zip(grid, combo):
             set_value(table, path, v)
-        tally, missed = run_variant(table, a.only, a.trials, os.path.join(root, "variant_%03d" % n))
+        tally, missed = run_variant(table, a.only, a.trials, os.path.join(root, "variant_%03d" % n),
+                                    os.path.join(baseline, "urdf") if table != own else None)
         print("%s: %s" % (label, tally))
         for m in missed:
             print("    mismatch: %s" % m)

@@ -1,6 +1,7 @@
 #!/usr/bin/python3
-"""sweep_description.py: a variant's value reaches the generated URDF that sbot_validate runs on, and
-a path that names nothing in the parameter table is refused by name before anything runs."""
+"""sweep_description.py: a variant's value reaches the generated URDF that sbot_validate runs on, a
+variant that changes no generated file is named and not run, and a path that names nothing in the
+parameter table is refused by name before anything runs."""
 import os
 import re
 import subprocess
@@ -36,6 +37,19 @@ class SweepDescription(unittest.TestCase):
             medium_turret = medium[medium.index('<link name="turret">'):]
             self.assertRegex(medium_turret[:400], r'<origin xyz="0.03 0 ')
             self.assertTrue(os.path.exists(os.path.join(keep, "variant_%03d" % n, "report", "report.md")))
+
+    def test_a_variant_that_changes_no_generated_file_is_named_and_not_run(self):
+        # Entries under `shared:` reach the levels through YAML aliases and merge keys at load time:
+        # setting one afterwards changes no level (a 2026-11-26 creep sweep ran three identical models).
+        keep = tempfile.mkdtemp(prefix="sweep_test_")
+        r = sweep("--grid", "shared.treels_api.creep_stiffness=3.0,5.6", "--only", "4.2", "--trials", "1",
+                  "--keep", keep)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertRegex(r.stdout, r"creep_stiffness=3.0: changes nothing in the generated descriptions, not run")
+        self.assertIn("levels.medium.treels.creep_stiffness", r.stdout, "says which path to set instead")
+        self.assertFalse(os.path.exists(os.path.join(keep, "variant_000", "report")))
+        # 5.6 is the table's own value: the reference point of the grid, run as any other.
+        self.assertRegex(r.stdout, r"creep_stiffness=5.6: hardware \d+/3")
 
     def test_a_misspelt_path_is_refused_by_name(self):
         r = sweep("--grid", "levels.medium.turet.com_m[0]=0.03")
