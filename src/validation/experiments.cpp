@@ -702,23 +702,24 @@ SideView sideView(const std::string& level) {
   // The left track's wheels: the centre one nearest the middle, the front one furthest ahead.
   const auto& wheels = d.treels.left_joints;
   if (wheels.empty()) throw ConfigError(d.sidecar_path, "treels.left_joints", "no driven wheels");
-  std::string centre = wheels.front(), front = wheels.front();
+  const JointDescription* centre = &jointNamed(d, wheels.front());
+  const JointDescription* front = centre;
   for (const auto& name : wheels) {
-    const Vec3 o = jointNamed(d, name).origin.position;
-    if (std::abs(o.x()) < std::abs(jointNamed(d, centre).origin.position.x())) centre = name;
-    if (o.x() > jointNamed(d, front).origin.position.x()) front = name;
+    const JointDescription& j = jointNamed(d, name);
+    if (std::abs(j.origin.position.x()) < std::abs(centre->origin.position.x())) centre = &j;
+    if (j.origin.position.x() > front->origin.position.x()) front = &j;
   }
   if (front == centre)
     throw ConfigError(d.sidecar_path, "treels.left_joints",
-                      "the step statics need a front wheel ahead of the centre wheel, found only '" + centre + "'");
-  for (const auto& name : {centre, front})
-    if (jointNamed(d, name).parent != d.root_link)
-      throw ConfigError(d.urdf_path, name, "a wheel hinge on '" + jointNamed(d, name).parent + "', expected one on " + d.root_link);
-  const Vec3 c = jointNamed(d, centre).origin.position, f = jointNamed(d, front).origin.position;
+                      "the step statics need a front wheel ahead of the centre wheel, found only '" + centre->name + "'");
+  for (const JointDescription* j : {centre, front})
+    if (j->parent != d.root_link)
+      throw ConfigError(d.urdf_path, j->name, "a wheel hinge on '" + j->parent + "', expected one on " + d.root_link);
+  const Vec3 c = centre->origin.position, f = front->origin.position;
   const Vec3 com = rest.r.basePose().inverse().transform(centreOfMass(rest.r, nullptr));
   SideView s;
-  s.centre_radius = d.wheelRadius(centre);
-  s.front_radius = d.wheelRadius(front);
+  s.centre_radius = d.wheelRadius(centre->name);
+  s.front_radius = d.wheelRadius(front->name);
   s.front_axle_x = f.x() - c.x();
   s.front_axle_z = f.z() - c.z();
   s.com_x = com.x() - c.x();

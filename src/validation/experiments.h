@@ -110,7 +110,8 @@ std::string restFacts(const std::string& level);
 /// Throws ConfigError for a level without a front wheel ahead of its centre wheel (Fast, Simple, Basic).
 SideView sideView(const std::string& level);
 
-/// Mass [kg] of `level`'s turret link and of the whole robot (what moving the turret's COM moves).
+/// The turret link's share of `level`'s whole mass (moving the turret's COM by dx moves the
+/// robot's by share * dx).
 double turretMassShare(const std::string& level);
 
 /// Static tipping angle [deg]: the robot stands (setSpeed(0,0), servos holding) while gravity tilts

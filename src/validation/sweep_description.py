@@ -174,7 +174,8 @@ def main():
         fixed = [parse_assignment(s, False) for s in a.set]
         grid = [parse_assignment(g, True) for g in a.grid]
         with open(TABLE, encoding="utf-8") as fh:
-            base = unshared(yaml.safe_load(fh))
+            own = unshared(yaml.safe_load(fh))  # the table as it is, to tell variants that change nothing
+        base = unshared(own)
         for path, (value,) in fixed:
             set_value(base, path, value)
         # Validate every grid path once before running anything.
@@ -188,8 +189,6 @@ def main():
     # The table's own descriptions, to tell a variant that changes nothing (see NO_CHANGE). A variant
     # that sets the table's own values (a grid's reference point) is run as any other.
     baseline = os.path.join(root, "baseline")
-    with open(TABLE, encoding="utf-8") as fh:
-        own = unshared(yaml.safe_load(fh))
     error = generate(own, baseline)
     if error:
         print("sweep_description: the table itself: %s" % error, file=sys.stderr)
