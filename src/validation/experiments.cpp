@@ -234,6 +234,8 @@ Outcome gapTrial(const std::string& level, double gap_m, int trial) {
   });
   o.value = r.basePose().position.x();
   o.value2 = z0 - r.basePose().position.z();
+  // Not across: a base that dropped more than 2 cm (1 cm for the half-size Fast) went into the gap.
+  if (o.label == "stuck" && o.value2 > 0.02 * s) o.label = "fall inside";
   return o;
 }
 
@@ -563,6 +565,52 @@ Outcome steadySpeedTrial(const std::string& level, int units) {
   Outcome o{"ok"};
   o.value = (b - a).head<2>().norm() / 3.0;
   return o;
+}
+
+// ---- the catalogue of trial kinds ----------------------------------------------------------------
+
+namespace {
+std::string g_rough_heightmap;  // setRoughHeightmap
+}  // namespace
+
+void setRoughHeightmap(const std::string& png) { g_rough_heightmap = png; }
+
+const std::vector<ExperimentKind>& experimentKinds() {
+  static const std::vector<ExperimentKind> kinds = {
+      {"gap", "gap width, m", 0.0, 0.3, {"pass", "fall inside", "stuck", "topple"},
+       [](const std::string& l, double p, int i) { return gapTrial(l, p, i); }},
+      {"step", "step height, m", 0.0, 0.1, {"pass", "fail", "topple"},
+       [](const std::string& l, double p, int i) { return stepTrial(l, p, false, i); }},
+      {"stepb", "step height, m", 0.0, 0.1, {"pass", "fail", "topple"},
+       [](const std::string& l, double p, int i) { return stepTrial(l, p, true, i); }},
+      {"slope", "slope, deg", 0.0, 89.0, {"full", "difficult", "slide", "topple b/w"},
+       [](const std::string& l, double p, int i) { return slopeHoldClimbTrial(l, p * M_PI / 180, false, i); }},
+      {"slopeb", "slope, deg", 0.0, 89.0, {"full", "difficult", "slide", "topple b/w"},
+       [](const std::string& l, double p, int i) { return slopeHoldClimbTrial(l, p * M_PI / 180, true, i); }},
+      {"uphill", "ramp angle, rad", 0.0, 1.5, {"climb", "c/c", "stuck", "slipping", "slide back", "topple"},
+       [](const std::string& l, double p, int i) { return uphillTrial(l, p, i); }},
+      {"downhill", "ramp angle, rad", 0.0, 1.5, {"pass", "topple", "c/c", "stuck"},
+       [](const std::string& l, double p, int i) { return downhillTrial(l, p, i); }},
+      {"rough", "height range HR, cm", 0.0, 100.0, {},
+       [](const std::string& l, double p, int i) { return roughTrial(l, p, i, g_rough_heightmap); }},
+      {"rtm", "simulated time, s", 0.1, 3600.0, {}, [](const std::string& l, double p, int) { return rtmTrial(l, p); }},
+      {"speed", "setSpeed units", -70.0, 70.0, {},
+       [](const std::string& l, double p, int) { return steadySpeedTrial(l, static_cast<int>(std::lround(p))); }},
+  };
+  return kinds;
+}
+
+const ExperimentKind* findExperimentKind(const std::string& name) {
+  for (const ExperimentKind& k : experimentKinds())
+    if (name == k.name) return &k;
+  return nullptr;
+}
+
+std::string experimentKindNames(bool labelled) {
+  std::string names;
+  for (const ExperimentKind& k : experimentKinds())
+    if (!labelled || !k.labels.empty()) names += (names.empty() ? "" : ", ") + k.name;
+  return names;
 }
 
 // ---- infrastructure -------------------------------------------------------------------------------

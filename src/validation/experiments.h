@@ -51,7 +51,8 @@ constexpr int kSlowUnits = 10;
 
 /// Table 4.2 / 4.5: drive at 2.8 cm/s across a gap `gap_m` wide between two 10 cm high platforms
 /// (Fast: half as wide, like its half-size terrain in 4.2.2).
-/// Labels: pass, stuck (fell inside or stuck at the edge), topple.
+/// Labels: pass, fall inside (its base dropped > 2 cm, Fast 1 cm), stuck (at the edge), topple.
+/// value = base x [m], value2 = how far the base dropped [m].
 Outcome gapTrial(const std::string& level, double gap_m, int trial);
 
 /// Table 4.3: drive into a step `height_m` high, forward (backward = false) or backward.
@@ -120,6 +121,24 @@ double turretMassShare(const std::string& level);
 /// slides 1 cm within a second without tilting (value2; 90 = never). `iterations` > 0 overrides the quickstep iterations (a
 /// converged reference).
 Outcome tippingAngle(const std::string& level, bool backward, int iterations = 0);
+
+/// One kind of trial, as `sbot_validate --trial KIND` and the reference tables
+/// (reference_tables.h) name it: the functions above with their parameter's unit and range.
+struct ExperimentKind {
+  std::string name;
+  std::string unit;                 ///< what the parameter is, and its unit ("gap width, m")
+  double min = 0, max = 0;          ///< the range it accepts (a negative gap builds nothing)
+  std::vector<std::string> labels;  ///< the labels its trials yield; empty: a measurement (value only)
+  std::function<Outcome(const std::string& level, double param, int trial)> run;
+};
+/// gap, step, stepb (backward), slope, slopeb (rear uphill), uphill, downhill: labelled;
+/// rough, rtm, speed: measurements. `rough` runs on setRoughHeightmap's image.
+const std::vector<ExperimentKind>& experimentKinds();
+/// nullptr for a name that is not a kind.
+const ExperimentKind* findExperimentKind(const std::string& name);
+/// "gap, step, ..." (only the labelled kinds: `labelled`).
+std::string experimentKindNames(bool labelled = false);
+void setRoughHeightmap(const std::string& png);
 
 /// Run `n` jobs in `processes` forked workers; job i returns fn(i). Results in job order. A job
 /// that crashes or throws yields label "error".

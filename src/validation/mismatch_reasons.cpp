@@ -6,19 +6,14 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "yaml_file.h"
+
 namespace sbot {
 namespace validation {
 
 MismatchReasons MismatchReasons::load(const std::string& path, const std::string& shown_as) {
   auto fail = [&](const std::string& why) { throw std::runtime_error("mismatch reasons " + path + ": " + why); };
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    fail("cannot be read");
-  } catch (const YAML::Exception& e) {
-    fail("not YAML (" + e.msg + ", line " + std::to_string(e.mark.line + 1) + ")");
-  }
+  const YAML::Node root = loadYamlFile("mismatch reasons", path);
   MismatchReasons r;
   r.source_ = shown_as.empty() ? path : shown_as;
   if (root.IsNull()) return r;  // an empty file: nothing explained

@@ -8,24 +8,14 @@
 #include <stdexcept>
 #include <string>
 
-#include <unistd.h>
-
-#include <yaml-cpp/yaml.h>
-
+#include "../common/temp_file.h"
 #include "mismatch_reasons.h"
 
 namespace v = sbot::validation;
 
 namespace {
 
-std::string writeTemp(const std::string& text) {
-  char path[] = "/tmp/mismatch_reasons_XXXXXX";
-  const int fd = mkstemp(path);
-  if (fd < 0) throw std::runtime_error("mkstemp");
-  close(fd);
-  std::ofstream(path) << text;
-  return path;
-}
+std::string writeTemp(const std::string& text) { return sbot_test::writeTempFile("mismatch_reasons", text); }
 
 /// The message load() refuses `text` with ("" when it loads).
 std::string refusal(const std::string& text) {
@@ -91,21 +81,4 @@ TEST(MismatchReasons, MalformedFilesAreRefusedWithTheFileAndTheProblem) {
   }
 }
 
-TEST(MismatchReasons, TheShippedFileNamesCellsAsTheReportDoes) {
-  // Every key is "<table> <cell>" with a table the report tallies, so that a typo cannot hide a
-  // reason from its cell (the report would then call the cell unexplained and the entry unused).
-  const std::string path = std::string(SWARMBOT3D_SOURCE_DIR) + "/" + v::kMismatchReasonsFile;
-  v::MismatchReasons r = v::MismatchReasons::load(path);
-  const YAML::Node root = YAML::LoadFile(path);
-  ASSERT_TRUE(root.IsMap());
-  EXPECT_GT(root.size(), 0u);
-  for (const auto& entry : root) {
-    const std::string key = entry.first.as<std::string>();
-    const std::string table = key.substr(0, key.find(' '));
-    EXPECT_TRUE(table == "4.1" || table == "4.1.3" || table == "4.2" || table == "4.3" || table == "4.5" || table == "4.6")
-        << key;
-    if (table == "4.5") EXPECT_NE(key.find(" cm "), std::string::npos) << key;
-    if (table == "4.6") EXPECT_NE(key.find(" rad "), std::string::npos) << key;
-    EXPECT_TRUE(r.explains(key));
-  }
-}
+// That every key of the shipped file names a cell the report runs: test_reference_tables.cpp.

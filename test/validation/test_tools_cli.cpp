@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <fstream>
 #include <string>
 
 #include "../common/run_process.h"
@@ -114,12 +115,51 @@ TEST(ToolsCli, IndexRunsAnotherTrialOfTheCell) {
 // and an unreadable height map (288 failed runs shown as "0.00 +- 0.00" in Figure 4.4).
 TEST(ToolsCli, UnknownSectionsAndUnreadableHeightMapsAreRefusedBeforeAnyRun) {
   const std::string out = "--out " + testing::TempDir() + "cli_refused ";
-  expectRefused("sbot_validate", out + "--only fig44", "--only: unknown section 'fig44' (sections: facts, 4.1");
+  expectRefused("sbot_validate", out + "--only fig44", "--only: unknown section 'fig44' (in config/validation/reference_tables.yaml: facts, 4.1,");
   expectRefused("sbot_validate", out + "--only fig4.4 --heightmap /nonexistent/map.png",
                 "--heightmap (or $SBOT_HEIGHTMAP): /nonexistent/map.png: field 'terrain.heightmap_image': cannot read image");
   // A report whose mismatches could not be explained is not written either.
   expectRefused("sbot_validate", out + "--only 4.2 --reasons /nonexistent/reasons.yaml",
                 "sbot_validate: --reasons: mismatch reasons /nonexistent/reasons.yaml: cannot be read");
+}
+
+// Reference tables other than the seed's (--tables): another lab's cells run, their mismatches are
+// tallied in their own group and decide the exit status when the group is required; a malformed
+// file is refused before any run, and --only names the file's own entries.
+TEST(ToolsCli, AnotherReferenceTableRunsAndDecidesTheExitStatus) {
+  const std::string dir = testing::TempDir() + "cli_tables/";
+  std::system(("mkdir -p " + dir).c_str());
+  auto tables = [&](const std::string& name, bool required, const std::string& wide_gap) {
+    std::ofstream(dir + name) << "groups:\n  - {name: lab, title: \"Lab cells\", required: " << (required ? "true" : "false")
+                              << "}\nreport:\n  - table:\n      id: lab1\n      title: Half-size gaps\n      group: lab\n"
+                                 "      experiment: gap\n      level: fast\n      param: {unit: mm, scale: 1000, decimals: 0}\n"
+                                 "      references: [measured]\n      cells:\n        - {param: 0.030, measured: pass}\n"
+                                 "        - {param: 0.065, measured: \""
+                              << wide_gap << "\"}\n";
+    return dir + name;
+  };
+  const std::string tool = std::string(SWARMBOT3D_BIN_DIR) + "/sbot_validate --trials 1 --jobs 1 --out " + dir;
+  // The Fast robot crosses a 3 cm gap and is stuck in 6.5 cm (the seed's Table 4.5, halved terrain).
+  Outcome o = sbot_test::runProcess(tool + "ok --tables " + tables("ok.yaml", true, "stuck|fall inside"));
+  EXPECT_EQ(o.status, 0) << o.output;
+  EXPECT_NE(o.output.find("| 65 mm | stuck or fall inside | stuck (stuck 1/1) | match |"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("- Lab cells matched: 2/2"), std::string::npos) << o.output;
+  EXPECT_EQ(o.output.find("Table 4.5"), std::string::npos) << "only the file's tables run: " << o.output;
+  // A reference the model does not meet: a mismatch, not explained yet, and exit status 1.
+  o = sbot_test::runProcess(tool + "bad --tables " + tables("bad.yaml", true, "pass"));
+  EXPECT_EQ(o.status, 1) << o.output;
+  EXPECT_NE(o.output.find("| 65 mm | pass | stuck (stuck 1/1) | **mismatch** |"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("*lab1 65 mm*: **not explained yet**"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("- Lab cells matched: 1/2"), std::string::npos) << o.output;
+  // The same mismatch in a group that is not required is reported but does not fail the run.
+  o = sbot_test::runProcess(tool + "optional --tables " + tables("optional.yaml", false, "pass"));
+  EXPECT_EQ(o.status, 0) << o.output;
+  // Refused before any run: a label the experiment never yields, and an entry the file does not have.
+  expectRefused("sbot_validate", "--out " + dir + "x --tables " + tables("typo.yaml", true, "stuk"),
+                "sbot_validate: --tables: reference tables " + dir + "typo.yaml: table 'lab1', cell 1: reference 'measured' "
+                "accepts 'stuk', which gap never yields");
+  expectRefused("sbot_validate", "--out " + dir + "x --only 4.5 --tables " + dir + "ok.yaml",
+                "--only: unknown section '4.5' (in " + dir + "ok.yaml: lab1)");
 }
 
 // A model description that cannot be read ($SBOT_DESCRIPTION_DIR, the sweep tool's variants): two_sbots

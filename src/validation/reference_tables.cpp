@@ -1,0 +1,274 @@
+#include "reference_tables.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <iomanip>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include <yaml-cpp/yaml.h>
+
+#include "experiments.h"
+#include "yaml_file.h"
+
+namespace sbot {
+namespace validation {
+
+bool ReferenceTable::severalLevels() const {
+  for (const ReferenceCell& c : cells)
+    if (c.level != cells.front().level) return true;
+  return false;
+}
+
+std::string ReferenceTable::paramText(const ReferenceCell& c) const {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(param_decimals) << c.param * param_scale;
+  return s.str() + (param_unit.empty() ? "" : " " + param_unit);
+}
+
+std::string ReferenceTable::key(const ReferenceCell& c) const {
+  return id + " " + paramText(c) + (c.variant.empty() ? "" : " " + c.variant) + (severalLevels() ? " " + c.level : "");
+}
+
+const ReferenceGroup* ReferenceTables::findGroup(const std::string& name) const {
+  for (const ReferenceGroup& g : groups)
+    if (g.name == name) return &g;
+  return nullptr;
+}
+
+namespace {
+
+/// "pass|stuck" as the report shows it: "pass or stuck" (a '|' would split the Markdown table's cell).
+std::string alternatives(const std::string& accepts) {
+  std::string out;
+  for (char ch : accepts) out += ch == '|' ? std::string(" or ") : std::string(1, ch);
+  return out;
+}
+
+bool contains(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
+
+std::string joined(const std::vector<std::string>& v) {
+  std::string s;
+  for (const std::string& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+/// Reads the fields of one YAML map, refusing any it does not know (a misspelt field would
+/// otherwise be silently ignored).
+class Fields {
+ public:
+  Fields(const YAML::Node& node, std::string where, const std::function<void(const std::string&)>& fail)
+      : node_(node), where_(std::move(where)), fail_(fail) {
+    if (!node.IsMap()) fail_(where_ + ": expected a map of fields");
+  }
+  bool has(const std::string& k) {
+    known_.insert(k);
+    return node_[k].IsDefined() && !node_[k].IsNull();
+  }
+  std::string text(const std::string& k, bool required, const std::string& fallback = "") {
+    if (!has(k)) {
+      if (required) fail_(where_ + ": missing field '" + k + "'");
+      return fallback;
+    }
+    if (!node_[k].IsScalar()) fail_(where_ + ": field '" + k + "' must be a text");
+    return node_[k].as<std::string>();
+  }
+  double number(const std::string& k, bool required, double fallback = 0) {
+    const std::string t = text(k, required, "");
+    if (t.empty()) return fallback;
+    char* end = nullptr;
+    const double v = std::strtod(t.c_str(), &end);
+    if (end == t.c_str() || *end != '\0' || !std::isfinite(v))
+      fail_(where_ + ": field '" + k + "' expects a finite number, found '" + t + "'");
+    return v;
+  }
+  bool flag(const std::string& k) {
+    const std::string t = text(k, false, "false");
+    if (t != "true" && t != "false") fail_(where_ + ": field '" + k + "' expects true or false, found '" + t + "'");
+    return t == "true";
+  }
+  std::vector<std::string> list(const std::string& k) {
+    std::vector<std::string> out;
+    if (!has(k)) return out;
+    if (!node_[k].IsSequence()) fail_(where_ + ": field '" + k + "' must be a list");
+    for (const auto& x : node_[k]) {
+      if (!x.IsScalar()) fail_(where_ + ": field '" + k + "' must be a list of texts");
+      out.push_back(x.as<std::string>());
+    }
+    return out;
+  }
+  YAML::Node node(const std::string& k) {
+    known_.insert(k);
+    return node_[k];
+  }
+  /// Call after reading: refuses fields nobody asked for.
+  void noOthers() {
+    for (const auto& kv : node_) {
+      const std::string k = kv.first.as<std::string>("");
+      if (!known_.count(k)) fail_(where_ + ": unknown field '" + k + "' (fields: " + joined({known_.begin(), known_.end()}) + ")");
+    }
+  }
+
+ private:
+  const YAML::Node node_;
+  const std::string where_;
+  const std::function<void(const std::string&)>& fail_;
+  std::set<std::string> known_;
+};
+
+ReferenceTable readTable(const YAML::Node& node, const std::string& where, const ReferenceTables& file,
+                         const ReferenceVocabulary& vocabulary, const std::function<void(const std::string&)>& fail) {
+  ReferenceTable t;
+  Fields f(node, where, fail);
+  t.id = f.text("id", true);
+  const std::string at = "table '" + t.id + "'";
+  t.title = f.text("title", true);
+  t.about = f.text("about", false);
+  t.group = f.text("group", false);
+  if (!t.group.empty() && !file.findGroup(t.group)) fail(at + ": group '" + t.group + "' is not defined under groups");
+  const std::string experiment = f.text("experiment", false);
+  const std::string level = f.text("level", false);
+  const std::string variant = f.text("variant", false);
+  t.variant_header = f.text("variant_header", false);
+  if (f.has("param")) {
+    Fields p(f.node("param"), at + ", param", fail);
+    t.param_header = p.text("header", false, t.param_header);
+    t.param_unit = p.text("unit", false);
+    t.param_scale = p.number("scale", false, 1);
+    t.param_decimals = static_cast<int>(p.number("decimals", false, 2));
+    if (t.param_decimals < 0 || t.param_decimals > 6) fail(at + ", param: decimals expects 0 to 6");
+    p.noOthers();
+  }
+  t.references = f.list("references");
+  if (t.references.empty()) fail(at + ": 'references' must name at least one column (the first is compared)");
+  t.ours_header = f.text("ours_header", false, t.ours_header);
+  if (f.has("companion")) {
+    Fields c(f.node("companion"), at + ", companion", fail);
+    t.companion = c.text("experiment", true);
+    t.companion_header = c.text("header", false, "ours, " + t.companion);
+    c.noOthers();
+    if (!findExperimentKind(t.companion) || findExperimentKind(t.companion)->labels.empty())
+      fail(at + ", companion: experiment '" + t.companion + "' is not one of " + experimentKindNames(true));
+  }
+  if (f.has("value")) {
+    Fields v(f.node("value"), at + ", value", fail);
+    t.value_header = v.text("header", true);
+    t.value_decimals = static_cast<int>(v.number("decimals", false, 2));
+    v.noOthers();
+  }
+  t.after = f.list("after");
+  for (const std::string& p : t.after)
+    if (!contains(vocabulary.paragraphs, p))
+      fail(at + ": 'after' names '" + p + "', not a built-in paragraph (" + joined(vocabulary.paragraphs) + ")");
+  if (!f.has("cells") || !f.node("cells").IsSequence() || f.node("cells").size() == 0)
+    fail(at + ": 'cells' must be a non-empty list");
+  std::set<std::string> keys;
+  int index = 0;
+  for (const auto& cn : f.node("cells")) {
+    const std::string cat = at + ", cell " + std::to_string(index++);
+    Fields cf(cn, cat, fail);
+    ReferenceCell c;
+    c.experiment = cf.text("experiment", experiment.empty(), experiment);
+    c.level = cf.text("level", level.empty(), level);
+    c.variant = cf.text("variant", false, variant);
+    c.param = cf.number("param", true);
+    const ExperimentKind* kind = findExperimentKind(c.experiment);
+    if (!kind || kind->labels.empty())
+      fail(cat + ": experiment '" + c.experiment + "' is not one of " + experimentKindNames(true));
+    if (c.param < kind->min || c.param > kind->max) {
+      std::ostringstream m;
+      m << cat << ": param " << c.param << " is outside " << c.experiment << "'s range [" << kind->min << ", " << kind->max
+        << "] (" << kind->unit << ")";
+      fail(m.str());
+    }
+    if (!contains(vocabulary.levels, c.level)) fail(cat + ": level '" + c.level + "' is not one of " + joined(vocabulary.levels));
+    for (std::size_t r = 0; r < t.references.size(); ++r) {
+      const std::string& column = t.references[r];
+      if (!cf.has(column)) fail(cat + ": missing the reference '" + column + "'");
+      const YAML::Node v = cf.node(column);
+      ReferenceValue value;
+      if (v.IsScalar()) {
+        value.accepts = v.as<std::string>();
+        value.text = r == 0 ? alternatives(value.accepts) : value.accepts;
+      } else {
+        Fields vf(v, cat + ", " + column, fail);
+        value.accepts = vf.text("accepts", true);
+        value.text = vf.text("text", false, value.accepts);
+        vf.noOthers();
+      }
+      if (r == 0) {  // the compared column: every alternative must be a label the experiment yields
+        std::stringstream ss(value.accepts);
+        for (std::string label; std::getline(ss, label, '|');)
+          if (!contains(kind->labels, label))
+            fail(cat + ": reference '" + column + "' accepts '" + label + "', which " + c.experiment +
+                 " never yields (its labels: " + joined(kind->labels) + ")");
+      } else {
+        value.accepts.clear();
+      }
+      if (value.text.empty()) fail(cat + ": reference '" + column + "' is empty");
+      if (value.text.find('|') != std::string::npos)
+        fail(cat + ": reference '" + column + "' shows '" + value.text + "': a '|' would split the report's table");
+      c.references.push_back(value);
+    }
+    cf.noOthers();
+    t.cells.push_back(c);
+  }
+  for (const ReferenceCell& c : t.cells)
+    if (!keys.insert(t.key(c)).second) fail(at + ": two cells are both '" + t.key(c) + "'");
+  f.noOthers();
+  return t;
+}
+
+}  // namespace
+
+ReferenceTables ReferenceTables::load(const std::string& path, const ReferenceVocabulary& vocabulary, const std::string& shown_as) {
+  const std::function<void(const std::string&)> fail = [&](const std::string& why) {
+    throw std::runtime_error("reference tables " + path + ": " + why);
+  };
+  const YAML::Node root = loadYamlFile("reference tables", path);
+  ReferenceTables file;
+  file.source = shown_as.empty() ? path : shown_as;
+  if (!root.IsMap()) fail("expected a map with 'groups' and 'report'");
+  Fields top(root, "the file", fail);
+  if (top.has("groups")) {
+    if (!top.node("groups").IsSequence()) fail("'groups' must be a list");
+    for (const auto& gn : top.node("groups")) {
+      Fields g(gn, "a group", fail);
+      ReferenceGroup group{g.text("name", true), g.text("title", true), g.flag("required")};
+      g.noOthers();
+      if (file.findGroup(group.name)) fail("group '" + group.name + "' is defined twice");
+      file.groups.push_back(group);
+    }
+  }
+  if (!top.has("report") || !top.node("report").IsSequence() || top.node("report").size() == 0)
+    fail("'report' must be a non-empty list of sections and tables");
+  top.noOthers();
+  std::set<std::string> names;
+  int index = 0;
+  for (const auto& en : root["report"]) {
+    const std::string where = "report entry " + std::to_string(index++);
+    Fields e(en, where, fail);
+    ReportEntry entry;
+    if (e.has("section")) {
+      entry.section = e.text("section", true);
+      if (!contains(vocabulary.sections, entry.section))
+        fail(where + ": section '" + entry.section + "' is not a built-in section (" + joined(vocabulary.sections) + ")");
+      for (const auto& [section, group] : vocabulary.section_groups)
+        if (section == entry.section && !file.findGroup(group))
+          fail(where + ": section '" + section + "' tallies its cells in group '" + group + "', which 'groups' does not define");
+    } else if (e.has("table")) {
+      entry.table = readTable(e.node("table"), where, file, vocabulary, fail);
+    } else {
+      fail(where + ": expected 'section: NAME' or 'table: {...}'");
+    }
+    e.noOthers();
+    if (!names.insert(entry.name()).second) fail(where + ": '" + entry.name() + "' appears twice in the report");
+    file.report.push_back(entry);
+  }
+  return file;
+}
+
+}  // namespace validation
+}  // namespace sbot

@@ -1,0 +1,25 @@
+// Reading one of the validation suite's YAML files (mismatch reasons, reference tables) with the
+// same two refusals: a file that cannot be read, and one that is not YAML (with the parser's line).
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+#include <yaml-cpp/yaml.h>
+
+namespace sbot {
+namespace validation {
+
+/// The parsed file; throws std::runtime_error("<what> <path>: cannot be read" / ": not YAML (...)").
+inline YAML::Node loadYamlFile(const std::string& what, const std::string& path) {
+  try {
+    return YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw std::runtime_error(what + " " + path + ": cannot be read");
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(what + " " + path + ": not YAML (" + e.msg + ", line " + std::to_string(e.mark.line + 1) + ")");
+  }
+}
+
+}  // namespace validation
+}  // namespace sbot
