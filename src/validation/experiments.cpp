@@ -24,8 +24,6 @@ namespace sbot {
 namespace validation {
 namespace {
 
-constexpr double kSlowSpeed = 0.0028 * kSlowUnits;  // [m/s]
-
 /// Length scale of a level's world: the Fast model is the Simple one at half size (seed 3.1).
 double lengthScale(const std::string& level) { return level == "fast" ? 0.5 : 1.0; }
 
@@ -202,7 +200,7 @@ bool studyKnobsOk(const char* tool) {
 
 // ---- Table 4.2 / 4.5: gap ------------------------------------------------------------------------
 
-Outcome gapTrial(const std::string& level, double gap_m, int trial) {
+Outcome gapTrial(const std::string& level, double gap_m, int trial, const Drive& drive) {
   const RobotDescription& d = loadLevel(level);
   const double s = lengthScale(level);
   Jitter j("gap" + level, gap_m, trial);
@@ -220,10 +218,10 @@ Outcome gapTrial(const std::string& level, double gap_m, int trial) {
   r.setSpeed(0, 0);
   w.stepN(static_cast<int>(0.3 / c.step));
   const double z0 = r.basePose().position.z();
-  r.setSpeed(kSlowUnits, kSlowUnits);
+  r.setSpeed(drive.units, drive.units);
   Outcome o{"stuck"};
   const double goal = gap / 2 + 0.09 * s;
-  runFor(w, (gap + 0.30 * s) / kSlowSpeed + 4.0, [&] {
+  runFor(w, (gap + 0.30 * s) / drive.speed() + 4.0, [&] {
     const Vec3 p = r.basePose().position;
     const double tilt = angleBetween(upOf(r), Vec3::UnitZ());
     // Not kToppledTilt: a robot wedged nose-first in the gap at 50-70 deg has fallen inside (the
@@ -241,7 +239,7 @@ Outcome gapTrial(const std::string& level, double gap_m, int trial) {
 
 // ---- Table 4.3: step ------------------------------------------------------------------------------
 
-Outcome stepTrial(const std::string& level, double height_m, bool backward, int trial) {
+Outcome stepTrial(const std::string& level, double height_m, bool backward, int trial, const Drive& drive) {
   const RobotDescription& d = loadLevel(level);
   const double s = lengthScale(level);
   Jitter j(std::string("step") + (backward ? "b" : "f") + level, height_m, trial);
@@ -255,10 +253,10 @@ Outcome stepTrial(const std::string& level, double height_m, bool backward, int 
   r.setSpeed(0, 0);
   w.stepN(static_cast<int>(0.3 / c.step));
   const double z0 = r.basePose().position.z();
-  const int u = backward ? -kSlowUnits : kSlowUnits;
+  const int u = backward ? -drive.units : drive.units;
   r.setSpeed(u, u);
   Outcome o{"fail"};
-  runFor(w, 0.25 * s / kSlowSpeed + 8.0, [&] {
+  runFor(w, 0.25 * s / drive.speed() + 8.0, [&] {
     const Vec3 p = r.basePose().position;
     const double tilt = angleBetween(upOf(r), Vec3::UnitZ());
     // A robot that reverses up a step nose-first onto its held gripper stands at 70-77 deg and can
@@ -276,7 +274,7 @@ Outcome stepTrial(const std::string& level, double height_m, bool backward, int 
 
 void onPolystyrene(WorldConfig& c) { c.contact.material_mu["track"] = kPolystyreneTrackMu; }
 
-Outcome slopeHoldClimbTrial(const std::string& level, double angle_rad, bool backward, int trial) {
+Outcome slopeHoldClimbTrial(const std::string& level, double angle_rad, bool backward, int trial, const Drive& drive) {
   const RobotDescription& d = loadLevel(level);
   Jitter j(std::string("slope") + (backward ? "b" : "f") + level, angle_rad, trial);
   WorldConfig c = configFor(d, 3000 + trial);
@@ -305,12 +303,12 @@ Outcome slopeHoldClimbTrial(const std::string& level, double angle_rad, bool bac
   const double hold_tilt = max_tilt;
   double progress = 0;
   if (!toppled) {
-    const int u = backward ? -kSlowUnits : kSlowUnits;
+    const int u = backward ? -drive.units : drive.units;
     r.setSpeed(u, u);
     const double t_climb = 8.0;
     runFor(w, t_climb, watch);
     progress = r.basePose().position.x() - x_hold;
-    o.value = progress / (kSlowSpeed * t_climb);
+    o.value = progress / (drive.speed() * t_climb);
   }
   o.value2 = max_tilt;
   if (toppled) o.label = "topple b/w";
@@ -322,7 +320,7 @@ Outcome slopeHoldClimbTrial(const std::string& level, double angle_rad, bool bac
 
 // ---- Table 4.6: uphill ramp from flat ground -----------------------------------------------------
 
-Outcome uphillTrial(const std::string& level, double angle_rad, int trial) {
+Outcome uphillTrial(const std::string& level, double angle_rad, int trial, const Drive& drive) {
   const RobotDescription& d = loadLevel(level);
   const double s = lengthScale(level);
   Jitter j("uphill" + level, angle_rad, trial);
@@ -336,7 +334,7 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial) {
   w.stepN(static_cast<int>(0.3 / c.step));
   const double h0 = headingOf(r);
   const double z0 = r.basePose().position.z();
-  r.setSpeed(kSlowUnits, kSlowUnits);
+  r.setSpeed(drive.units, drive.units);
   const Vec3 normal(-std::sin(angle_rad), 0, std::cos(angle_rad));
   double best = 0;
   Outcome o{"stuck"};
@@ -350,8 +348,8 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial) {
   std::deque<Vec3> positions;
   const double weight = d.totalMass() * c.gravity;
   const std::size_t window = static_cast<std::size_t>(std::lround(2.0 / (checkEvery(w) * c.step)));  // 2 s
-  runFor(w, (0.12 * s + 0.30 * s) / kSlowSpeed * 1.3 + 4.0, [&] {
-    track_ratio.push_back(0.5 * (std::fabs(r.trackSpeedLeft()) + std::fabs(r.trackSpeedRight())) / kSlowSpeed);
+  runFor(w, (0.12 * s + 0.30 * s) / drive.speed() * 1.3 + 4.0, [&] {
+    track_ratio.push_back(0.5 * (std::fabs(r.trackSpeedLeft()) + std::fabs(r.trackSpeedRight())) / drive.speed());
     load_ratio.push_back(r.driveWheelLoad() / weight);
     positions.push_back(r.basePose().position);
     if (track_ratio.size() > window) { track_ratio.pop_front(); load_ratio.pop_front(); positions.pop_front(); }
@@ -382,7 +380,7 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial) {
     // needs tracks that turn (encoders >= 50 % of the command) while the driven wheels carry at
     // least a quarter of the weight. Tracks spinning free (the robot hung up on its chassis or
     // casters) do not slip: that robot is stuck.
-    const bool travelling = travel >= 0.25 * kSlowSpeed * 2.0;
+    const bool travelling = travel >= 0.25 * drive.speed() * 2.0;
     if (best > 0.03 * s && along() < best - 0.03 * s) o.label = "slide back";
     else if (best <= 0.05 * s && dh > kCourseChange && travelling) o.label = "c/c";
     else if (turning >= 0.5 && load >= 0.25) o.label = "slipping";
@@ -390,7 +388,7 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial) {
   return o;
 }
 
-Outcome downhillTrial(const std::string& level, double angle_rad, int trial) {
+Outcome downhillTrial(const std::string& level, double angle_rad, int trial, const Drive& drive) {
   const RobotDescription& d = loadLevel(level);
   const double s = lengthScale(level);
   Jitter j("downhill" + level, angle_rad, trial);
@@ -405,11 +403,11 @@ Outcome downhillTrial(const std::string& level, double angle_rad, int trial) {
   r.setSpeed(0, 0);
   w.stepN(static_cast<int>(0.3 / c.step));
   const double h0 = headingOf(r);
-  r.setSpeed(kSlowUnits, kSlowUnits);
+  r.setSpeed(drive.units, drive.units);
   Outcome o{"stuck"};
   const double foot = L * std::cos(angle_rad), goal = foot + 0.10 * s;
   const Vec3 ramp_normal(std::sin(angle_rad), 0, std::cos(angle_rad));  // the ramp falls toward +x
-  runFor(w, (0.10 * s + L + 0.1 * s) / kSlowSpeed * 1.3 + 4.0, [&] {
+  runFor(w, (0.10 * s + L + 0.1 * s) / drive.speed() * 1.3 + 4.0, [&] {
     // Toppled forward: over, or tilted more than 45 deg off the normal of the surface under its
     // base (plateau, ramp, floor), i.e. pitched onto its nose or gripper (Table 4.3's rule). Until
     // 2026-11-26 only "over" (100 deg) counted, and a Detailed robot that pitched 84 deg onto its
@@ -578,24 +576,24 @@ void setRoughHeightmap(const std::string& png) { g_rough_heightmap = png; }
 const std::vector<ExperimentKind>& experimentKinds() {
   static const std::vector<ExperimentKind> kinds = {
       {"gap", "gap width, m", 0.0, 0.3, {"pass", "fall inside", "stuck", "topple"},
-       [](const std::string& l, double p, int i) { return gapTrial(l, p, i); }},
+       [](const std::string& l, double p, int i, const Drive& d) { return gapTrial(l, p, i, d); }},
       {"step", "step height, m", 0.0, 0.1, {"pass", "fail", "topple"},
-       [](const std::string& l, double p, int i) { return stepTrial(l, p, false, i); }},
+       [](const std::string& l, double p, int i, const Drive& d) { return stepTrial(l, p, false, i, d); }},
       {"stepb", "step height, m", 0.0, 0.1, {"pass", "fail", "topple"},
-       [](const std::string& l, double p, int i) { return stepTrial(l, p, true, i); }},
+       [](const std::string& l, double p, int i, const Drive& d) { return stepTrial(l, p, true, i, d); }},
       {"slope", "slope, deg", 0.0, 89.0, {"full", "difficult", "slide", "topple b/w"},
-       [](const std::string& l, double p, int i) { return slopeHoldClimbTrial(l, p * M_PI / 180, false, i); }},
+       [](const std::string& l, double p, int i, const Drive& d) { return slopeHoldClimbTrial(l, p * M_PI / 180, false, i, d); }},
       {"slopeb", "slope, deg", 0.0, 89.0, {"full", "difficult", "slide", "topple b/w"},
-       [](const std::string& l, double p, int i) { return slopeHoldClimbTrial(l, p * M_PI / 180, true, i); }},
+       [](const std::string& l, double p, int i, const Drive& d) { return slopeHoldClimbTrial(l, p * M_PI / 180, true, i, d); }},
       {"uphill", "ramp angle, rad", 0.0, 1.5, {"climb", "c/c", "stuck", "slipping", "slide back", "topple"},
-       [](const std::string& l, double p, int i) { return uphillTrial(l, p, i); }},
+       [](const std::string& l, double p, int i, const Drive& d) { return uphillTrial(l, p, i, d); }},
       {"downhill", "ramp angle, rad", 0.0, 1.5, {"pass", "topple", "c/c", "stuck"},
-       [](const std::string& l, double p, int i) { return downhillTrial(l, p, i); }},
+       [](const std::string& l, double p, int i, const Drive& d) { return downhillTrial(l, p, i, d); }},
       {"rough", "height range HR, cm", 0.0, 100.0, {},
-       [](const std::string& l, double p, int i) { return roughTrial(l, p, i, g_rough_heightmap); }},
-      {"rtm", "simulated time, s", 0.1, 3600.0, {}, [](const std::string& l, double p, int) { return rtmTrial(l, p); }},
+       [](const std::string& l, double p, int i, const Drive&) { return roughTrial(l, p, i, g_rough_heightmap); }},
+      {"rtm", "simulated time, s", 0.1, 3600.0, {}, [](const std::string& l, double p, int, const Drive&) { return rtmTrial(l, p); }},
       {"speed", "setSpeed units", -70.0, 70.0, {},
-       [](const std::string& l, double p, int) { return steadySpeedTrial(l, static_cast<int>(std::lround(p))); }},
+       [](const std::string& l, double p, int, const Drive&) { return steadySpeedTrial(l, static_cast<int>(std::lround(p))); }},
   };
   return kinds;
 }

@@ -49,15 +49,22 @@ bool studyKnobsOk(const char* tool);
 /// Speed used by the seed for gap and slope experiments (4.2.3, 4.2.4): 2.8 cm/s = 10 API units.
 constexpr int kSlowUnits = 10;
 
+/// How a gap, step, slope or ramp trial drives: setSpeed(units, units), the seed's 2.8 cm/s unless
+/// a reference table asks for another speed. The trial's time limits scale with it.
+struct Drive {
+  int units = kSlowUnits;                        ///< setSpeed units, 1..70 (Table 2.2: 0.28 cm/s each)
+  double speed() const { return 0.0028 * units; }  ///< [m/s]
+};
+
 /// Table 4.2 / 4.5: drive at 2.8 cm/s across a gap `gap_m` wide between two 10 cm high platforms
 /// (Fast: half as wide, like its half-size terrain in 4.2.2).
 /// Labels: pass, fall inside (its base dropped > 2 cm, Fast 1 cm), stuck (at the edge), topple.
 /// value = base x [m], value2 = how far the base dropped [m].
-Outcome gapTrial(const std::string& level, double gap_m, int trial);
+Outcome gapTrial(const std::string& level, double gap_m, int trial, const Drive& drive = Drive());
 
 /// Table 4.3: drive into a step `height_m` high, forward (backward = false) or backward.
 /// Labels: pass, fail, topple.
-Outcome stepTrial(const std::string& level, double height_m, bool backward, int trial);
+Outcome stepTrial(const std::string& level, double height_m, bool backward, int trial, const Drive& drive = Drive());
 
 /// Table 4.1's slope is "a rigid polystyrene plastic" (4.1.1), a surface of its own: the treels'
 /// Coulomb coefficient on it. The seed gives none; the hardware pair stood upright on 58 deg, which
@@ -71,14 +78,15 @@ void onPolystyrene(WorldConfig& c);
 /// with the motors holding, then climb 8 s at 2.8 cm/s. `backward`: the robot faces downhill and
 /// climbs in reverse. Labels: full, difficult, slide, topple b/w. value = climb efficiency
 /// (progress / commanded).
-Outcome slopeHoldClimbTrial(const std::string& level, double angle_rad, bool backward, int trial);
+Outcome slopeHoldClimbTrial(const std::string& level, double angle_rad, bool backward, int trial,
+                             const Drive& drive = Drive());
 
 /// Table 4.6: drive from flat ground at 2.8 cm/s into an uphill ramp of `angle_rad`.
 /// Labels: climb, c/c, stuck, slipping, slide back, topple.
-Outcome uphillTrial(const std::string& level, double angle_rad, int trial);
+Outcome uphillTrial(const std::string& level, double angle_rad, int trial, const Drive& drive = Drive());
 
 /// 4.2.4 downhill: drive from a plateau down a ramp of `angle_rad`. Labels: pass, topple, stuck.
-Outcome downhillTrial(const std::string& level, double angle_rad, int trial);
+Outcome downhillTrial(const std::string& level, double angle_rad, int trial, const Drive& drive = Drive());
 
 /// Figure 4.4: random pose and heading on rough terrain of height range `hr_cm` [cm], 10 s at
 /// 15.24 cm/s; value = travelled distance projected on the initial heading [m].
@@ -129,7 +137,8 @@ struct ExperimentKind {
   std::string unit;                 ///< what the parameter is, and its unit ("gap width, m")
   double min = 0, max = 0;          ///< the range it accepts (a negative gap builds nothing)
   std::vector<std::string> labels;  ///< the labels its trials yield; empty: a measurement (value only)
-  std::function<Outcome(const std::string& level, double param, int trial)> run;
+  /// The trial; `drive` applies to the labelled kinds (the measurements have their own speeds).
+  std::function<Outcome(const std::string& level, double param, int trial, const Drive& drive)> run;
 };
 /// gap, step, stepb (backward), slope, slopeb (rear uphill), uphill, downhill: labelled;
 /// rough, rtm, speed: measurements. `rough` runs on setRoughHeightmap's image.

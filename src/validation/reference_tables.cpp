@@ -22,6 +22,12 @@ bool ReferenceTable::severalLevels() const {
   return false;
 }
 
+bool ReferenceTable::otherSpeeds() const {
+  for (const ReferenceCell& c : cells)
+    if (c.speed_units != kSlowUnits) return true;
+  return false;
+}
+
 std::string ReferenceTable::paramText(const ReferenceCell& c) const {
   std::ostringstream s;
   s << std::fixed << std::setprecision(param_decimals) << c.param * param_scale;
@@ -131,6 +137,7 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
   const std::string experiment = f.text("experiment", false);
   const std::string level = f.text("level", false);
   const std::string variant = f.text("variant", false);
+  const double speed_units = f.number("speed_units", false, kSlowUnits);
   t.variant_header = f.text("variant_header", false);
   if (f.has("param")) {
     Fields p(f.node("param"), at + ", param", fail);
@@ -174,6 +181,11 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
     c.level = cf.text("level", level.empty(), level);
     c.variant = cf.text("variant", false, variant);
     c.param = cf.number("param", true);
+    const double units = cf.number("speed_units", false, speed_units);
+    if (units != std::round(units) || units < 1 || units > 70)
+      fail(cat + ": speed_units expects a whole number of setSpeed units in [1, 70] (0.28 cm/s each), found " +
+           std::to_string(units));
+    c.speed_units = static_cast<int>(units);
     const ExperimentKind* kind = findExperimentKind(c.experiment);
     if (!kind || kind->labels.empty())
       fail(cat + ": experiment '" + c.experiment + "' is not one of " + experimentKindNames(true));

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "experiments.h"
+
 namespace sbot {
 namespace validation {
 
@@ -29,6 +31,7 @@ struct ReferenceCell {
   std::string level;       ///< a model level
   double param = 0;        ///< the kind's parameter, in its unit (gap width m, slope deg, ramp rad)
   std::string variant;     ///< a row label beside the parameter ("backward"), may be empty
+  int speed_units = kSlowUnits;  ///< the drive's setSpeed units (Drive; the seed's 2.8 cm/s)
   std::vector<ReferenceValue> references;  ///< one per ReferenceTable::references; [0] is compared
 };
 
@@ -53,6 +56,8 @@ struct ReferenceTable {
 
   /// Whether the cells span more than one level (the report then has a level column).
   bool severalLevels() const;
+  /// Whether a cell drives at other than the seed's 2.8 cm/s (the report then has a speed column).
+  bool otherSpeeds() const;
   /// The parameter as shown ("15 mm").
   std::string paramText(const ReferenceCell& c) const;
   /// The cell's name in the report and in the mismatch reasons: "<id> <param> [<variant>] [<level>]"

@@ -14,10 +14,10 @@
 // Exit status: 0 when every cell of the file's required groups (the seed's: the hardware cells of
 // Tables 4.1-4.3) matches, 1 otherwise, 2 on bad usage.
 //
-//   sbot_validate [--trace] [--index N] --trial KIND LEVEL PARAM    one trial, printed (tuning aid);
-//     --trace prints the robot's state every 0.1 s (pose, attitude, wheel load, track speeds,
-//     turret angle, gripper tip); --index N runs the cell's trial N (its start
-//     perturbation, as in the report; default 0)
+//   sbot_validate [--trace] [--index N] [--speed UNITS] --trial KIND LEVEL PARAM    one trial, printed
+//     (tuning aid); --trace prints the robot's state every 0.1 s (pose, attitude, wheel load, track
+//     speeds, turret angle, gripper tip); --index N runs the cell's trial N (its start
+//     perturbation, as in the report; default 0); --speed: setSpeed units (default 10, 2.8 cm/s)
 // KIND: gap, step, stepb, slope, slopeb, uphill, downhill, rough, rtm, speed (PARAM: m, m, m, deg,
 // deg, rad, rad, HR in cm, simulated s, setSpeed units of the compatibility check; ranges in
 // experimentKinds(), experiments.h).
@@ -505,7 +505,7 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
   const std::vector<Outcome> res = v::runParallel(kinds * cells * o.trials, o.jobs, [&](int i) {
     const int run = i / (cells * o.trials), cell = (i / o.trials) % cells;
     const v::ReferenceCell& c = t.cells[cell];
-    return v::findExperimentKind(run == 0 ? c.experiment : t.companion)->run(c.level, c.param, i % o.trials);
+    return v::findExperimentKind(run == 0 ? c.experiment : t.companion)->run(c.level, c.param, i % o.trials, v::Drive{c.speed_units});
   });
   auto outcomes = [&](int run, int cell) {
     const auto first = res.begin() + (run * cells + cell) * o.trials;
@@ -524,6 +524,7 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
   std::vector<std::string> columns{t.param_header};
   if (!t.variant_header.empty()) columns.push_back(t.variant_header);
   if (levels) columns.push_back("level");
+  if (t.otherSpeeds()) columns.push_back("speed [cm/s]");
   columns.insert(columns.end(), t.references.begin(), t.references.end());
   columns.push_back(t.ours_header);
   if (tallied) columns.push_back("match");
@@ -541,6 +542,7 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
     md << "| " << t.paramText(c);
     if (!t.variant_header.empty()) md << " | " << c.variant;
     if (levels) md << " | " << c.level;
+    if (t.otherSpeeds()) md << " | " << fmt(v::Drive{c.speed_units}.speed() * 100, 2);
     for (const v::ReferenceValue& r : c.references) md << " | " << r.text;
     md << " | " << m.text << " (" << summary(ours) << ")";
     if (tallied) {
@@ -566,6 +568,7 @@ int main(int argc, char** argv) {
   Options o;
   bool trace = false;
   int index = 0;  // --index: which trial of a cell --trial runs (its start perturbation)
+  v::Drive drive;  // --speed: the labelled trials' setSpeed units (default: the seed's 2.8 cm/s)
   sbot_tools::ArgReader args("sbot_validate", argc, argv);
   while (args.more()) {
     const std::string a = args.option();
@@ -578,6 +581,7 @@ int main(int argc, char** argv) {
     else if (a == "--tables") o.tables = args.value();
     else if (a == "--trace") trace = true;  // with --trial (before it): the robot's state every 0.1 s
     else if (a == "--index") index = args.count(0, 999);  // with --trial (before it): the cell's trial N
+    else if (a == "--speed") drive.units = args.count(1, 70);  // with --trial (before it): setSpeed units
     else if (a == "--trial") {  // --trial KIND LEVEL PARAM: one trial, printed (tuning aid)
       const std::string kind = args.value(), level = args.value();
       const v::ExperimentKind* k = v::findExperimentKind(kind);
@@ -590,7 +594,7 @@ int main(int argc, char** argv) {
                                              args.value(), k->min, k->max);
       v::setTrace(trace);
       v::setRoughHeightmap(findHeightmap());
-      const Outcome r = k->run(level, p, index);
+      const Outcome r = k->run(level, p, index, drive);
       std::printf("%s %s %g: %s %g %g\n", kind.c_str(), level.c_str(), p, r.label.c_str(), r.value, r.value2);
       return 0;
     }
@@ -600,7 +604,7 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr, "usage: sbot_validate --out DIR [--quick] [--trials N] [--jobs N] [--only LIST]\n"
                            "                     [--tables YAML] [--reasons YAML] [--heightmap PNG]\n"
-                           "       sbot_validate [--trace] [--index N] --trial KIND LEVEL PARAM\n");
+                           "       sbot_validate [--trace] [--index N] [--speed UNITS] --trial KIND LEVEL PARAM\n");
       return a == "--help" ? 0 : 2;
     }
   }

@@ -133,6 +133,8 @@ TEST(ReferenceTables, AnotherLabsTableLoadsWithItsOwnNamesAndDefaults) {
   EXPECT_TRUE(table.severalLevels());
   EXPECT_EQ(table.key(table.cells[0]), "lab1 30 mm medium");
   EXPECT_EQ(table.cells[1].references[0].text, "stuck or fall inside") << "a '|' would split the Markdown table";
+  EXPECT_EQ(table.cells[0].speed_units, v::kSlowUnits) << "the seed's 2.8 cm/s unless the table says otherwise";
+  EXPECT_FALSE(table.otherSpeeds());
 }
 
 TEST(ReferenceTables, MalformedFilesAreRefusedWithTheEntryAndTheProblem) {
@@ -153,6 +155,8 @@ TEST(ReferenceTables, MalformedFilesAreRefusedWithTheEntryAndTheProblem) {
         "two cells are both 'lab1 30 mm'"},
       {with("        - {param: 0.030, measured: pass}\n", "        - {param: 0.030, measured: {accepts: pass, text: \"a|b\"}}\n"),
         "a '|' would split the report's table"},
+      {with("level: basic, ", "level: basic, speed_units: 2.5, "), "cell 2: speed_units expects a whole number of setSpeed units in [1, 70]"},
+      {with("level: medium\n", "level: medium\n      speed_units: 71\n"), "cell 0: speed_units expects a whole number"},
       {with("required: true", "required: maybe"), "field 'required' expects true or false, found 'maybe'"},
       {with("report:\n", "report:\n  - section: rtm\n"), "section 'rtm' is not a built-in section"},
       {with("report:\n", "report:\n  - section: 4.1pair\n"), "tallies its cells in group 'hardware', which 'groups' does not define"},

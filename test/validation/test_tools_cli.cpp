@@ -162,6 +162,25 @@ TEST(ToolsCli, AnotherReferenceTableRunsAndDecidesTheExitStatus) {
                 "--only: unknown section '4.5' (in " + dir + "ok.yaml: lab1)");
 }
 
+// A table's cells can drive at another speed than the seed's 2.8 cm/s (speed_units): the Medium is
+// stuck in a 4 cm gap at 2.8 cm/s and crosses it on its momentum at 16.8 cm/s (the seed's reason for
+// driving slowly, 4.2.3); the report then shows each cell's speed.
+TEST(ToolsCli, ATableCellDrivesAtItsOwnSpeed) {
+  const std::string dir = testing::TempDir() + "cli_speed/";
+  std::system(("mkdir -p " + dir).c_str());
+  std::ofstream(dir + "speed.yaml") << "groups:\n  - {name: lab, title: \"Lab cells\", required: true}\nreport:\n  - table:\n"
+                                       "      id: fast_gap\n      title: Gap at two speeds\n      group: lab\n"
+                                       "      experiment: gap\n      level: medium\n      param: {unit: cm, scale: 100, decimals: 1}\n"
+                                       "      references: [measured]\n      cells:\n"
+                                       "        - {param: 0.040, variant: slow, measured: stuck}\n"
+                                       "        - {param: 0.040, variant: fast, speed_units: 60, measured: pass}\n";
+  const Outcome o = sbot_test::runProcess(std::string(SWARMBOT3D_BIN_DIR) + "/sbot_validate --trials 1 --jobs 1 --out " + dir +
+                                          "report --tables " + dir + "speed.yaml");
+  EXPECT_EQ(o.status, 0) << o.output;
+  EXPECT_NE(o.output.find("| 4.0 cm | 2.80 | stuck | stuck (stuck 1/1) | match |"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("| 4.0 cm | 16.80 | pass | pass (pass 1/1) | match |"), std::string::npos) << o.output;
+}
+
 // A model description that cannot be read ($SBOT_DESCRIPTION_DIR, the sweep tool's variants): two_sbots
 // and sbot_validate --trial aborted on an uncaught exception, and a report was written anyway with every
 // model fact "error" and every static tipping angle "> 90 deg" (a failed run read as a number), status 0.
