@@ -2,13 +2,15 @@
 """Run validation sections on variants of the s-bot parameter table (a tuning aid).
 
     sweep_description.py [--set PATH=VALUE ...] [--grid PATH=V1,V2,... ...]
-                         [--only 4.1,4.2,4.3] [--trials 3] [--keep DIR]
+                         [--only 4.1,4.2,4.3] [--trials 3] [--keep DIR] [--tables YAML]
 
 Each variant is the table (sbot_description/config/sbot_parameters.yaml) with the --set values and
 one combination of the --grid values applied. Its URDFs and sidecars are generated into a directory
 of their own, and `sbot_validate` runs the sections on them through $SBOT_DESCRIPTION_DIR, so the
-source tree is never touched. One line per variant: the cells matched per table and the mismatched
-cells.
+source tree is never touched. One line per variant: the cells matched per group and the mismatched
+cells. --tables runs your own reference tables (sbot_validate --tables; src/validation/README.md)
+instead of the seed's, all of their sections unless --only names some: a parameter swept against
+your own measurements.
 
 PATH is a dotted path into the table, with [i] for list elements, e.g.
   --grid 'levels.detailed.turret.com_m[0]=0.030,0.035,0.040'
@@ -99,14 +101,16 @@ def parse_assignment(text, many):
     return path.strip(), values
 
 
+# The seed's groups by their short names; another tables file's groups go by their titles.
+SHORT_NAMES = {"Hardware cells of Tables 4.1-4.3": "hardware", "Table 4.5 cells": "4.5", "Table 4.6 cells": "4.6"}
+
+
 def summary(report_md):
-    """'hardware 12/16, 4.5 21/28, ...' and the mismatched rows of a report."""
+    """'hardware 12/16, 4.5 21/28, ...' (every group the report tallies) and its mismatched rows."""
     with open(report_md, encoding="utf-8") as fh:
         text = fh.read()
-    counts = re.findall(r"^- (Hardware cells of Tables 4.1-4.3|Table 4.5 cells|Table 4.6 cells) matched: (\d+/\d+)",
-                        text, re.M)
-    names = {"Hardware cells of Tables 4.1-4.3": "hardware", "Table 4.5 cells": "4.5", "Table 4.6 cells": "4.6"}
-    tally = ", ".join("%s %s" % (names[n], c) for n, c in counts)
+    counts = re.findall(r"^- (.+) matched: (\d+/\d+)$", text, re.M)
+    tally = ", ".join("%s %s" % (SHORT_NAMES.get(n, n), c) for n, c in counts)
     missed = [" | ".join(c.strip() for c in row.strip().strip("|").split("|") if "mismatch" not in c)
               for row in text.splitlines() if row.startswith("| ") and "**mismatch**" in row]
     return tally, missed
@@ -142,7 +146,7 @@ def same_files(dir_a, dir_b):
     return all(filecmp.cmp(os.path.join(dir_a, n), os.path.join(dir_b, n), shallow=False) for n in names)
 
 
-def run_variant(table, only, trials, workdir, baseline_urdf=None):
+def run_variant(table, only, trials, workdir, baseline_urdf=None, tables=None):
     """Generate and validate one variant: (tally, mismatched rows). A variant whose generated files
     equal `baseline_urdf`'s changes nothing the simulator reads and is not run."""
     error = generate(table, workdir)
@@ -152,8 +156,9 @@ def run_variant(table, only, trials, workdir, baseline_urdf=None):
         return NO_CHANGE, []
     env = dict(os.environ, SBOT_DESCRIPTION_DIR=workdir)
     out = os.path.join(workdir, "report")
-    val = subprocess.run(validate_command() + ["--out", out, "--only", only, "--trials", str(trials)], env=env,
-                         capture_output=True, text=True)
+    args = ["--out", out, "--trials", str(trials)] + (["--only", only] if only else [])
+    args += ["--tables", tables] if tables else []
+    val = subprocess.run(validate_command() + args, env=env, capture_output=True, text=True)
     report = os.path.join(out, "report.md")
     if not os.path.exists(report):
         return "sbot_validate failed (status %d): %s" % (val.returncode, val.stderr.strip()[-300:]), []
@@ -164,12 +169,19 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--set", action="append", default=[], metavar="PATH=VALUE")
     ap.add_argument("--grid", action="append", default=[], metavar="PATH=V1,V2,...")
-    ap.add_argument("--only", default="4.1,4.2,4.3", help="sbot_validate sections (default 4.1,4.2,4.3)")
+    ap.add_argument("--only", help="sbot_validate sections (default 4.1,4.2,4.3; with --tables: all)")
+    ap.add_argument("--tables", help="reference tables for sbot_validate (default: the seed's)")
     ap.add_argument("--trials", type=int, default=3, help="trials per cell (default 3)")
     ap.add_argument("--keep", help="keep every variant's files (params, URDFs, report) under this directory")
     a = ap.parse_args()
     if a.trials < 1:
         ap.error("--trials expects a whole number >= 1, found %d" % a.trials)
+    if a.tables:
+        if not os.path.isfile(a.tables):
+            ap.error("--tables: %s is not a file" % a.tables)
+        a.tables = os.path.abspath(a.tables)  # sbot_validate runs elsewhere
+    elif a.only is None:
+        a.only = "4.1,4.2,4.3"
     try:
         fixed = [parse_assignment(s, False) for s in a.set]
         grid = [parse_assignment(g, True) for g in a.grid]
@@ -194,14 +206,15 @@ def main():
         print("sweep_description: the table itself: %s" % error, file=sys.stderr)
         return 2
     combos = list(itertools.product(*[values for _, values in grid])) or [()]
-    print("%d variant(s); sections %s, %d trial(s) per cell; files in %s" % (len(combos), a.only, a.trials, root))
+    print("%d variant(s); sections %s%s, %d trial(s) per cell; files in %s"
+          % (len(combos), a.only or "all", " of " + a.tables if a.tables else "", a.trials, root))
     for n, combo in enumerate(combos):
         table = unshared(base)
         label = ", ".join("%s=%s" % (path, v) for (path, _), v in zip(grid, combo)) or "table as set"
         for (path, _), v in zip(grid, combo):
             set_value(table, path, v)
         tally, missed = run_variant(table, a.only, a.trials, os.path.join(root, "variant_%03d" % n),
-                                    os.path.join(baseline, "urdf") if table != own else None)
+                                    os.path.join(baseline, "urdf") if table != own else None, a.tables)
         print("%s: %s" % (label, tally))
         for m in missed:
             print("    mismatch: %s" % m)

@@ -51,6 +51,26 @@ class SweepDescription(unittest.TestCase):
         # 5.6 is the table's own value: the reference point of the grid, run as any other.
         self.assertRegex(r.stdout, r"creep_stiffness=5.6: hardware \d+/3")
 
+    def test_a_sweep_runs_against_another_labs_tables(self):
+        # --tables: the variants (here the Medium's front and rear sphere radius) are validated
+        # against your own reference tables, and each line tallies that file's group.
+        d = tempfile.mkdtemp(prefix="sweep_test_")
+        tables = os.path.join(d, "lab.yaml")
+        with open(tables, "w", encoding="utf-8") as fh:
+            fh.write("groups:\n  - {name: lab, title: Lab cells, required: true}\nreport:\n  - table:\n"
+                     "      id: lab1\n      title: Gaps\n      group: lab\n      experiment: gap\n"
+                     "      level: medium\n      param: {unit: cm, scale: 100, decimals: 1}\n"
+                     "      references: [measured]\n      cells:\n        - {param: 0.030, measured: pass}\n")
+        r = sweep("--grid", "levels.medium.wheels.front_rear.radius_m=0.020,0.018", "--tables", tables, "--trials", "1")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("sections all of " + tables, r.stdout)
+        self.assertRegex(r.stdout, r"radius_m=0.02: Lab cells \d/1")
+        self.assertRegex(r.stdout, r"radius_m=0.018: Lab cells \d/1")
+        self.assertNotIn("hardware", r.stdout, "the seed's tables did not run")
+        r = sweep("--grid", "levels.medium.wheels.front_rear.radius_m=0.020", "--tables", os.path.join(d, "none.yaml"))
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("none.yaml is not a file", r.stderr)
+
     def test_a_misspelt_path_is_refused_by_name(self):
         r = sweep("--grid", "levels.medium.turet.com_m[0]=0.03")
         self.assertEqual(r.returncode, 2)
