@@ -162,7 +162,9 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
   if (f.has("value")) {
     Fields v(f.node("value"), at + ", value", fail);
     t.value_header = v.text("header", true);
+    t.value_scale = v.number("scale", false, 1);
     t.value_decimals = static_cast<int>(v.number("decimals", false, 2));
+    if (t.value_decimals < 0 || t.value_decimals > 6) fail(at + ", value: decimals expects 0 to 6");
     v.noOthers();
   }
   t.after = f.list("after");

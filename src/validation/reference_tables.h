@@ -49,7 +49,8 @@ struct ReferenceTable {
   std::string ours_header = "ours";
   std::string companion;        ///< optional experiment run on the same cells, shown, not tallied
   std::string companion_header;
-  std::string value_header;     ///< optional column: the mean measured value (Outcome::value)
+  std::string value_header;     ///< optional column: the mean measured value (Outcome::value) x value_scale
+  double value_scale = 1;
   int value_decimals = 2;
   std::vector<std::string> after;  ///< built-in paragraphs printed under the table (by name)
   std::vector<ReferenceCell> cells;

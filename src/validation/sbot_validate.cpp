@@ -511,12 +511,12 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
     const auto first = res.begin() + (run * cells + cell) * o.trials;
     return std::vector<Outcome>(first, first + o.trials);
   };
-  auto meanValue = [](const std::vector<Outcome>& os) {
+  auto meanValue = [&](const std::vector<Outcome>& os) {
     double sum = 0;
     int n = 0;
     for (const Outcome& x : os)
       if (!failed(x)) { sum += x.value; ++n; }
-    return n ? fmt(sum / n) : std::string("error");
+    return n ? fmt(sum / n * t.value_scale, t.value_decimals) : std::string("error");
   };
   const bool tallied = !t.group.empty(), levels = t.severalLevels();
   md << "## " << t.title << " (modal of " << o.trials << ")\n\n";

@@ -57,6 +57,7 @@ const std::string kLab =
     "      level: medium\n"
     "      param: {header: gap, unit: mm, scale: 1000, decimals: 0}\n"
     "      references: [measured]\n"
+    "      value: {header: \"base x [cm]\", scale: 100, decimals: 1}\n"
     "      cells:\n"
     "        - {param: 0.030, measured: pass}\n"
     "        - {param: 0.060, measured: \"stuck|fall inside\"}\n"
@@ -135,6 +136,9 @@ TEST(ReferenceTables, AnotherLabsTableLoadsWithItsOwnNamesAndDefaults) {
   EXPECT_EQ(table.cells[1].references[0].text, "stuck or fall inside") << "a '|' would split the Markdown table";
   EXPECT_EQ(table.cells[0].speed_units, v::kSlowUnits) << "the seed's 2.8 cm/s unless the table says otherwise";
   EXPECT_FALSE(table.otherSpeeds());
+  EXPECT_EQ(table.value_header, "base x [cm]");
+  EXPECT_EQ(table.value_scale, 100);
+  EXPECT_EQ(table.value_decimals, 1);
 }
 
 TEST(ReferenceTables, MalformedFilesAreRefusedWithTheEntryAndTheProblem) {
@@ -157,6 +161,7 @@ TEST(ReferenceTables, MalformedFilesAreRefusedWithTheEntryAndTheProblem) {
         "a '|' would split the report's table"},
       {with("level: basic, ", "level: basic, speed_units: 2.5, "), "cell 2: speed_units expects a whole number of setSpeed units in [1, 70]"},
       {with("level: medium\n", "level: medium\n      speed_units: 71\n"), "cell 0: speed_units expects a whole number"},
+      {with("decimals: 1}", "decimals: 9}"), "table 'lab1', value: decimals expects 0 to 6"},
       {with("required: true", "required: maybe"), "field 'required' expects true or false, found 'maybe'"},
       {with("report:\n", "report:\n  - section: rtm\n"), "section 'rtm' is not a built-in section"},
       {with("report:\n", "report:\n  - section: 4.1pair\n"), "tallies its cells in group 'hardware', which 'groups' does not define"},
