@@ -18,14 +18,13 @@
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/sensors/environment.h"
 #include "sbot_sim/core/sensors/sensor_suite.h"
+#include "sbot_sim/core/swarm/swarm_graph.h"
 #include "sbot_sim/core/world.h"
 
 namespace sbot {
 namespace validation {
 namespace {
 
-/// Length scale of a level's world: the Fast model is the Simple one at half size (seed 3.1).
-double lengthScale(const std::string& level) { return level == "fast" ? 0.5 : 1.0; }
 
 WorldConfig configFor(const RobotDescription& d, std::uint64_t seed) {
   WorldConfig c;
@@ -565,6 +564,26 @@ Outcome steadySpeedTrial(const std::string& level, int units) {
   return o;
 }
 
+Outcome connectedPairTrial(const std::string& level) {
+  const RobotDescription& d = loadLevel(level);
+  WorldConfig c = configFor(d, 9);
+  World w(c);
+  Robot& holder = w.addRobot(d, {0, 0, 0}, "holder");
+  Robot& held = w.addRobot(d, {0.3 * lengthScale(level), 0, 0}, "held");
+  holdServos(holder);
+  holdServos(held);
+  swarm::createStaticLink(w, {"holder", "held", swarm::kFrontGripper});
+  auto distance = [&] { return (held.basePose().position - holder.basePose().position).head<2>().norm(); };
+  runFor(w, 1.0, [] { return false; });
+  Outcome o{"ok"};
+  o.value = distance();
+  holder.setSpeed(-30, -30);
+  held.setSpeed(-30, -30);
+  runFor(w, 2.0, [] { return false; });
+  o.value2 = distance();
+  return o;
+}
+
 // ---- the catalogue of trial kinds ----------------------------------------------------------------
 
 namespace {
@@ -610,6 +629,8 @@ std::string experimentKindNames(bool labelled) {
     if (!labelled || !k.labels.empty()) names += (names.empty() ? "" : ", ") + k.name;
   return names;
 }
+
+double lengthScale(const std::string& level) { return level == "fast" ? 0.5 : 1.0; }
 
 // ---- infrastructure -------------------------------------------------------------------------------
 

@@ -111,6 +111,15 @@ StepCost profileTrial(const std::string& level, double sim_seconds);
 /// Seed 2.1.3: steady speed [m/s] at setSpeed(units, units) on flat ground (value).
 Outcome steadySpeedTrial(const std::string& level, int units);
 
+/// Seed 2.1.3, the other half of compatibility: two s-bots of `level` on flat ground, the second
+/// held by the first's front gripper (a static link, swarm/swarm_graph.h), stand 1 s, then reverse
+/// together at 30 units for 2 s. value = their centre-to-centre distance after standing [m],
+/// value2 = after reversing [m] (the link holds the pair at the level's length scale).
+Outcome connectedPairTrial(const std::string& level);
+
+/// The length scale of a level's robot: 0.5 for the half-size Fast model (seed 3.1), else 1.
+double lengthScale(const std::string& level);
+
 /// Mass, bodies, centre of mass (base frame and height) and rest attitude on flat ground after 2 s.
 std::string restFacts(const std::string& level);
 

@@ -67,6 +67,20 @@ TEST(ValidationDecisive, HardwareCells) {
   }
 }
 
+TEST(ValidationCompatibility, EveryLevelsConnectedPairStandsAtItsScaledDistance) {
+  // Seed 2.1.3: two s-bots connected by the front gripper are the same distance apart at every
+  // level (0.147 m centre to centre; the half-size Fast pair half of it), standing and after
+  // reversing together (the link holds).
+  const std::vector<std::string> levels{"fast", "simple", "basic", "medium", "detailed"};
+  const auto r = v::runParallel(static_cast<int>(levels.size()), 2, [&](int i) { return v::connectedPairTrial(levels[i]); });
+  for (std::size_t i = 0; i < levels.size(); ++i) {
+    ASSERT_NE(r[i].label, "error") << levels[i];
+    const double scale = v::lengthScale(levels[i]);
+    EXPECT_NEAR(r[i].value / scale, 0.147, 0.003) << levels[i] << " standing";
+    EXPECT_NEAR(r[i].value2 / scale, 0.147, 0.003) << levels[i] << " after reversing";
+  }
+}
+
 TEST(ValidationFacts, DetailedTipsOverItsFrontNearTheStaticLimit) {
   // The centre of mass 1.5 cm ahead of the centre wheels and 4.6 cm above the ground (the turret's
   // calibrated COM), the front axle 4 cm ahead: facing downhill the robot tips at
