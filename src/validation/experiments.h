@@ -139,6 +139,12 @@ double turretMassShare(const std::string& level);
 /// converged reference).
 Outcome tippingAngle(const std::string& level, bool backward, int iterations = 0);
 
+/// What a trial measures besides its label (Outcome::value or value2): a name, and its unit.
+struct Measure {
+  std::string name;  ///< "" when the kind does not fill it
+  std::string unit;
+};
+
 /// One kind of trial, as `sbot_validate --trial KIND` and the reference tables
 /// (reference_tables.h) name it: the functions above with their parameter's unit and range.
 struct ExperimentKind {
@@ -146,6 +152,7 @@ struct ExperimentKind {
   std::string unit;                 ///< what the parameter is, and its unit ("gap width, m")
   double min = 0, max = 0;          ///< the range it accepts (a negative gap builds nothing)
   std::vector<std::string> labels;  ///< the labels its trials yield; empty: a measurement (value only)
+  Measure value, value2;            ///< what Outcome::value and value2 measure
   /// The trial; `drive` applies to the labelled kinds (the measurements have their own speeds).
   std::function<Outcome(const std::string& level, double param, int trial, const Drive& drive)> run;
 };

@@ -621,7 +621,10 @@ int main(int argc, char** argv) {
       v::setTrace(trace);
       v::setRoughHeightmap(findHeightmap());
       const Outcome r = k->run(level, p, index, drive);
-      std::printf("%s %s %g: %s %g %g\n", kind.c_str(), level.c_str(), p, r.label.c_str(), r.value, r.value2);
+      std::printf("%s %s %g: %s", kind.c_str(), level.c_str(), p, r.label.c_str());
+      for (const auto& [m, x] : {std::make_pair(k->value, r.value), std::make_pair(k->value2, r.value2)})
+        if (!m.name.empty()) std::printf("; %s %g%s", m.name.c_str(), x, m.unit.empty() ? "" : (" " + m.unit).c_str());
+      std::printf("\n");
       return 0;
     }
     else if (a == "--only") {

@@ -90,7 +90,8 @@ TEST(ToolsCli, UnusableStudyKnobsAreRefusedByName) {
   const Outcome slick = sbot_test::runProcess("env SBOT_VALIDATE_TRACK_MU=0 " + std::string(SWARMBOT3D_BIN_DIR) +
                                               "/sbot_validate --trial step detailed 0.010");
   EXPECT_EQ(slick.status, 0) << slick.output;
-  EXPECT_NE(slick.output.find("step detailed 0.01: fail"), std::string::npos) << slick.output;
+  EXPECT_NE(slick.output.find("step detailed 0.01: fail; base x at the end (step edge at 0) "), std::string::npos)
+      << "the label, then what the trial measured, named: " << slick.output;
   // A usable value is taken: one trial at 60 iterations.
   const Outcome o = sbot_test::runProcess("env SBOT_VALIDATE_ITERATIONS=60 " + std::string(SWARMBOT3D_BIN_DIR) +
                                           "/sbot_validate --trial step detailed 0.010");
