@@ -28,11 +28,13 @@ bool ReferenceTable::otherSpeeds() const {
   return false;
 }
 
-std::string ReferenceTable::paramText(const ReferenceCell& c) const {
+std::string NumberFormat::text(double v) const {
   std::ostringstream s;
-  s << std::fixed << std::setprecision(param_decimals) << c.param * param_scale;
-  return s.str() + (param_unit.empty() ? "" : " " + param_unit);
+  s << std::fixed << std::setprecision(decimals) << v * scale;
+  return s.str() + (unit.empty() ? "" : " " + unit);
 }
+
+std::string ReferenceTable::paramText(const ReferenceCell& c) const { return param.text(c.param); }
 
 std::string ReferenceTable::key(const ReferenceCell& c) const {
   return id + " " + paramText(c) + (c.variant.empty() ? "" : " " + c.variant) + (severalLevels() ? " " + c.level : "");
@@ -124,6 +126,22 @@ class Fields {
   std::set<std::string> known_;
 };
 
+/// {header, unit, scale, decimals}; without `default_header` the header is required.
+NumberFormat readFormat(const YAML::Node& node, const std::string& where, const std::string& default_header,
+                        const std::function<void(const std::string&)>& fail) {
+  Fields f(node, where, fail);
+  NumberFormat n;
+  n.header = f.text("header", default_header.empty(), default_header);
+  n.unit = f.text("unit", false);
+  n.scale = f.number("scale", false, 1);
+  const double decimals = f.number("decimals", false, 2);
+  if (decimals != std::round(decimals) || decimals < 0 || decimals > 6)
+    fail(where + ": decimals expects a whole number from 0 to 6, found '" + f.text("decimals", false) + "'");
+  n.decimals = static_cast<int>(decimals);
+  f.noOthers();
+  return n;
+}
+
 ReferenceTable readTable(const YAML::Node& node, const std::string& where, const ReferenceTables& file,
                          const ReferenceVocabulary& vocabulary, const std::function<void(const std::string&)>& fail) {
   ReferenceTable t;
@@ -139,15 +157,7 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
   const std::string variant = f.text("variant", false);
   const double speed_units = f.number("speed_units", false, kSlowUnits);
   t.variant_header = f.text("variant_header", false);
-  if (f.has("param")) {
-    Fields p(f.node("param"), at + ", param", fail);
-    t.param_header = p.text("header", false, t.param_header);
-    t.param_unit = p.text("unit", false);
-    t.param_scale = p.number("scale", false, 1);
-    t.param_decimals = static_cast<int>(p.number("decimals", false, 2));
-    if (t.param_decimals < 0 || t.param_decimals > 6) fail(at + ", param: decimals expects 0 to 6");
-    p.noOthers();
-  }
+  if (f.has("param")) t.param = readFormat(f.node("param"), at + ", param", t.param.header, fail);
   t.references = f.list("references");
   if (t.references.empty()) fail(at + ": 'references' must name at least one column (the first is compared)");
   t.ours_header = f.text("ours_header", false, t.ours_header);
@@ -159,14 +169,7 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
     if (!findExperimentKind(t.companion) || findExperimentKind(t.companion)->labels.empty())
       fail(at + ", companion: experiment '" + t.companion + "' is not one of " + experimentKindNames(true));
   }
-  if (f.has("value")) {
-    Fields v(f.node("value"), at + ", value", fail);
-    t.value_header = v.text("header", true);
-    t.value_scale = v.number("scale", false, 1);
-    t.value_decimals = static_cast<int>(v.number("decimals", false, 2));
-    if (t.value_decimals < 0 || t.value_decimals > 6) fail(at + ", value: decimals expects 0 to 6");
-    v.noOthers();
-  }
+  if (f.has("value")) t.value = readFormat(f.node("value"), at + ", value", "", fail);
   t.after = f.list("after");
   for (const std::string& p : t.after)
     if (!contains(vocabulary.paragraphs, p))

@@ -35,23 +35,27 @@ struct ReferenceCell {
   std::vector<ReferenceValue> references;  ///< one per ReferenceTable::references; [0] is compared
 };
 
+/// How a table shows a number: its column header, value x scale with `decimals`, then the unit.
+struct NumberFormat {
+  std::string header;
+  std::string unit;   ///< after the number ("mm"); may be empty
+  double scale = 1;   ///< a gap in m shown in mm: 1000
+  int decimals = 2;
+  std::string text(double v) const;  ///< "15 mm"
+};
+
 struct ReferenceTable {
   std::string id;           ///< "4.3": names the table's cells ("4.3 15 mm backward") and --only
   std::string title;        ///< the report's heading
   std::string about;        ///< Markdown under the heading: the set-up and the labels' meaning
   std::string group;        ///< the tally its cells count in; empty: shown, not tallied
-  std::string param_header = "parameter";
-  std::string param_unit;   ///< as shown ("mm"), after multiplying by param_scale
-  double param_scale = 1;   ///< shown = param * scale (a gap in m shown in mm: 1000)
-  int param_decimals = 2;
+  NumberFormat param{"parameter"};  ///< how the cells' parameters are shown (and named)
   std::string variant_header;  ///< column of the cells' variants; empty: no such column
   std::vector<std::string> references;  ///< column headers; the first is the one compared
   std::string ours_header = "ours";
   std::string companion;        ///< optional experiment run on the same cells, shown, not tallied
   std::string companion_header;
-  std::string value_header;     ///< optional column: the mean measured value (Outcome::value) x value_scale
-  double value_scale = 1;
-  int value_decimals = 2;
+  NumberFormat value;            ///< optional column (header set): the mean measured Outcome::value
   std::vector<std::string> after;  ///< built-in paragraphs printed under the table (by name)
   std::vector<ReferenceCell> cells;
 

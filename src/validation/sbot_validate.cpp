@@ -542,12 +542,12 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
     int n = 0;
     for (const Outcome& x : os)
       if (!failed(x)) { sum += x.value; ++n; }
-    return n ? fmt(sum / n * t.value_scale, t.value_decimals) : std::string("error");
+    return n ? t.value.text(sum / n) : std::string("error");
   };
   const bool tallied = !t.group.empty(), levels = t.severalLevels();
   md << "## " << t.title << " (modal of " << o.trials << ")\n\n";
   if (!t.about.empty()) md << t.about << "\n\n";
-  std::vector<std::string> columns{t.param_header};
+  std::vector<std::string> columns{t.param.header};
   if (!t.variant_header.empty()) columns.push_back(t.variant_header);
   if (levels) columns.push_back("level");
   if (t.otherSpeeds()) columns.push_back("speed [cm/s]");
@@ -555,7 +555,7 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
   columns.push_back(t.ours_header);
   if (tallied) columns.push_back("match");
   if (!t.companion.empty()) columns.push_back(t.companion_header);
-  if (!t.value_header.empty()) columns.push_back(t.value_header);
+  if (!t.value.header.empty()) columns.push_back(t.value.header);
   for (const std::string& c : columns) md << "| " << c << " ";
   md << "|\n";
   for (std::size_t k = 0; k < columns.size(); ++k) md << "|---";
@@ -577,7 +577,7 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
       table.match += m.ok;
     }
     if (!t.companion.empty()) md << " | " << modalCell("", outcomes(1, k)).text << " (" << summary(outcomes(1, k)) << ")";
-    if (!t.value_header.empty())
+    if (!t.value.header.empty())
       md << " | " << meanValue(ours) << (t.companion.empty() ? "" : " / " + meanValue(outcomes(1, k)));
     md << " |\n";
   }

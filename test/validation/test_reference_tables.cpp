@@ -136,9 +136,9 @@ TEST(ReferenceTables, AnotherLabsTableLoadsWithItsOwnNamesAndDefaults) {
   EXPECT_EQ(table.cells[1].references[0].text, "stuck or fall inside") << "a '|' would split the Markdown table";
   EXPECT_EQ(table.cells[0].speed_units, v::kSlowUnits) << "the seed's 2.8 cm/s unless the table says otherwise";
   EXPECT_FALSE(table.otherSpeeds());
-  EXPECT_EQ(table.value_header, "base x [cm]");
-  EXPECT_EQ(table.value_scale, 100);
-  EXPECT_EQ(table.value_decimals, 1);
+  EXPECT_EQ(table.value.header, "base x [cm]");
+  EXPECT_EQ(table.value.text(0.0123), "1.2") << "x scale, decimals, no unit";
+  EXPECT_EQ(table.param.text(0.035), "35 mm");
 }
 
 TEST(ReferenceTables, MalformedFilesAreRefusedWithTheEntryAndTheProblem) {
@@ -161,7 +161,7 @@ TEST(ReferenceTables, MalformedFilesAreRefusedWithTheEntryAndTheProblem) {
         "a '|' would split the report's table"},
       {with("level: basic, ", "level: basic, speed_units: 2.5, "), "cell 2: speed_units expects a whole number of setSpeed units in [1, 70]"},
       {with("level: medium\n", "level: medium\n      speed_units: 71\n"), "cell 0: speed_units expects a whole number"},
-      {with("decimals: 1}", "decimals: 9}"), "table 'lab1', value: decimals expects 0 to 6"},
+      {with("decimals: 1}", "decimals: 9}"), "table 'lab1', value: decimals expects a whole number from 0 to 6, found '9'"},
       {with("required: true", "required: maybe"), "field 'required' expects true or false, found 'maybe'"},
       {with("report:\n", "report:\n  - section: rtm\n"), "section 'rtm' is not a built-in section"},
       {with("report:\n", "report:\n  - section: 4.1pair\n"), "tallies its cells in group 'hardware', which 'groups' does not define"},
