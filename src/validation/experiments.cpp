@@ -220,7 +220,7 @@ Outcome gapTrial(const std::string& level, double gap_m, int trial, const Drive&
   r.setSpeed(drive.units, drive.units);
   Outcome o{"stuck"};
   const double goal = gap / 2 + 0.09 * s;
-  runFor(w, (gap + 0.30 * s) / drive.speed() + 4.0, [&] {
+  runFor(w, (gap + 0.30 * s) / drive.speed(d) + 4.0, [&] {
     const Vec3 p = r.basePose().position;
     const double tilt = angleBetween(upOf(r), Vec3::UnitZ());
     // Not kToppledTilt: a robot wedged nose-first in the gap at 50-70 deg has fallen inside (the
@@ -255,7 +255,7 @@ Outcome stepTrial(const std::string& level, double height_m, bool backward, int 
   const int u = backward ? -drive.units : drive.units;
   r.setSpeed(u, u);
   Outcome o{"fail"};
-  runFor(w, 0.25 * s / drive.speed() + 8.0, [&] {
+  runFor(w, 0.25 * s / drive.speed(d) + 8.0, [&] {
     const Vec3 p = r.basePose().position;
     const double tilt = angleBetween(upOf(r), Vec3::UnitZ());
     // A robot that reverses up a step nose-first onto its held gripper stands at 70-77 deg and can
@@ -307,7 +307,7 @@ Outcome slopeHoldClimbTrial(const std::string& level, double angle_rad, bool bac
     const double t_climb = 8.0;
     runFor(w, t_climb, watch);
     progress = r.basePose().position.x() - x_hold;
-    o.value = progress / (drive.speed() * t_climb);
+    o.value = progress / (drive.speed(d) * t_climb);
   }
   o.value2 = max_tilt;
   if (toppled) o.label = "topple b/w";
@@ -347,8 +347,8 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial, const
   std::deque<Vec3> positions;
   const double weight = d.totalMass() * c.gravity;
   const std::size_t window = static_cast<std::size_t>(std::lround(2.0 / (checkEvery(w) * c.step)));  // 2 s
-  runFor(w, (0.12 * s + 0.30 * s) / drive.speed() * 1.3 + 4.0, [&] {
-    track_ratio.push_back(0.5 * (std::fabs(r.trackSpeedLeft()) + std::fabs(r.trackSpeedRight())) / drive.speed());
+  runFor(w, (0.12 * s + 0.30 * s) / drive.speed(d) * 1.3 + 4.0, [&] {
+    track_ratio.push_back(0.5 * (std::fabs(r.trackSpeedLeft()) + std::fabs(r.trackSpeedRight())) / drive.speed(d));
     load_ratio.push_back(r.driveWheelLoad() / weight);
     positions.push_back(r.basePose().position);
     if (track_ratio.size() > window) { track_ratio.pop_front(); load_ratio.pop_front(); positions.pop_front(); }
@@ -379,7 +379,7 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial, const
     // needs tracks that turn (encoders >= 50 % of the command) while the driven wheels carry at
     // least a quarter of the weight. Tracks spinning free (the robot hung up on its chassis or
     // casters) do not slip: that robot is stuck.
-    const bool travelling = travel >= 0.25 * drive.speed() * 2.0;
+    const bool travelling = travel >= 0.25 * drive.speed(d) * 2.0;
     if (best > 0.03 * s && along() < best - 0.03 * s) o.label = "slide back";
     else if (best <= 0.05 * s && dh > kCourseChange && travelling) o.label = "c/c";
     else if (turning >= 0.5 && load >= 0.25) o.label = "slipping";
@@ -406,7 +406,7 @@ Outcome downhillTrial(const std::string& level, double angle_rad, int trial, con
   Outcome o{"stuck"};
   const double foot = L * std::cos(angle_rad), goal = foot + 0.10 * s;
   const Vec3 ramp_normal(std::sin(angle_rad), 0, std::cos(angle_rad));  // the ramp falls toward +x
-  runFor(w, (0.10 * s + L + 0.1 * s) / drive.speed() * 1.3 + 4.0, [&] {
+  runFor(w, (0.10 * s + L + 0.1 * s) / drive.speed(d) * 1.3 + 4.0, [&] {
     // Toppled forward: over, or tilted more than 45 deg off the normal of the surface under its
     // base (plateau, ramp, floor), i.e. pitched onto its nose or gripper (Table 4.3's rule). Until
     // 2026-11-26 only "over" (100 deg) counted, and a Detailed robot that pitched 84 deg onto its
@@ -634,6 +634,8 @@ std::string experimentKindNames(bool labelled) {
     if (!labelled || !k.labels.empty()) names += (names.empty() ? "" : ", ") + k.name;
   return names;
 }
+
+double Drive::speed(const RobotDescription& d) const { return units * d.treels.speed_unit; }
 
 double lengthScale(const std::string& level) { return level == "fast" ? 0.5 : 1.0; }
 

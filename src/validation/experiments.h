@@ -16,6 +16,7 @@
 #include "step_statics.h"
 
 namespace sbot {
+struct RobotDescription;
 struct WorldConfig;
 namespace validation {
 
@@ -52,8 +53,9 @@ constexpr int kSlowUnits = 10;
 /// How a gap, step, slope or ramp trial drives: setSpeed(units, units), the seed's 2.8 cm/s unless
 /// a reference table asks for another speed. The trial's time limits scale with it.
 struct Drive {
-  int units = kSlowUnits;                        ///< setSpeed units, 1..70 (Table 2.2: 0.28 cm/s each)
-  double speed() const { return 0.0028 * units; }  ///< [m/s]
+  int units = kSlowUnits;  ///< setSpeed units, 1..70
+  /// [m/s]: the units times the level's API speed unit (treels.speed_unit; Table 2.2: 0.28 cm/s).
+  double speed(const RobotDescription& d) const;
 };
 
 /// Table 4.2 / 4.5: drive at 2.8 cm/s across a gap `gap_m` wide between two 10 cm high platforms

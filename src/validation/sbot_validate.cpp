@@ -446,7 +446,7 @@ void writeCompat(std::ostream& md, const Options& o) {
   auto r = v::runParallel(2 * n, o.jobs, [&](int i) {
     return i < n ? v::steadySpeedTrial(kAllLevels[i], 50) : v::connectedPairTrial(kAllLevels[i - n]);
   });
-  const int ref = n - 1;  // detailed
+  const int ref = static_cast<int>(std::find(kAllLevels.begin(), kAllLevels.end(), "detailed") - kAllLevels.begin());
   md << "## Compatibility (seed 2.1.3)\n\n"
      << "Steady speed at setSpeed(50,50) = 14.0 cm/s on flat ground, and two s-bots of the level connected by "
         "the front gripper (static link): their centre-to-centre distance standing 1 s and after reversing "
@@ -544,13 +544,13 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
       if (!failed(x)) { sum += x.value; ++n; }
     return n ? t.value.text(sum / n) : std::string("error");
   };
-  const bool tallied = !t.group.empty(), levels = t.severalLevels();
+  const bool tallied = !t.group.empty(), levels = t.severalLevels(), speeds = t.otherSpeeds();
   md << "## " << t.title << " (modal of " << o.trials << ")\n\n";
   if (!t.about.empty()) md << t.about << "\n\n";
   std::vector<std::string> columns{t.param.header};
   if (!t.variant_header.empty()) columns.push_back(t.variant_header);
   if (levels) columns.push_back("level");
-  if (t.otherSpeeds()) columns.push_back("speed [cm/s]");
+  if (speeds) columns.push_back("speed [cm/s]");
   columns.insert(columns.end(), t.references.begin(), t.references.end());
   columns.push_back(t.ours_header);
   if (tallied) columns.push_back("match");
@@ -568,7 +568,7 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
     md << "| " << t.paramText(c);
     if (!t.variant_header.empty()) md << " | " << c.variant;
     if (levels) md << " | " << c.level;
-    if (t.otherSpeeds()) md << " | " << fmt(v::Drive{c.speed_units}.speed() * 100, 2);
+    if (speeds) md << " | " << fmt(v::Drive{c.speed_units}.speed(sbot::loadLevel(c.level)) * 100, 2);
     for (const v::ReferenceValue& r : c.references) md << " | " << r.text;
     md << " | " << m.text << " (" << summary(ours) << ")";
     if (tallied) {
