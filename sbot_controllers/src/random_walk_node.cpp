@@ -61,7 +61,7 @@ class RandomWalk {
       sbot_controllers::pollUntil([this] { return sub_.getNumPublishers() > 0 && pub_.getNumSubscribers() > 0; },
                                   std::chrono::steady_clock::now() + std::chrono::seconds(10));
       next_tick_ = ros::Time(0) + period_;
-      announceNextTick();
+      announceNextTick(/*new_subscription=*/true);
       ROS_INFO("random_walk %s: in lock-step with the simulator", nh.getNamespace().c_str());
     } else {
       sub_ = nh.subscribe("ground_truth", 1, &RandomWalk::onPose, this);
@@ -88,7 +88,9 @@ class RandomWalk {
   }
 
   /// Lock-step: the simulator may run until it publishes the ground truth of the next tick.
-  void announceNextTick() { lockstep_->waitingFor("ground_truth", next_tick_ - ros::Duration(0, 1), sent_); }
+  void announceNextTick(bool new_subscription = false) {
+    lockstep_->waitingFor("ground_truth", next_tick_ - ros::Duration(0, 1), sent_, 0, new_subscription);
+  }
 
   void onTimer(const ros::TimerEvent&) {
     if (have_pose_) act(ros::Time::now());  // sim time under /use_sim_time

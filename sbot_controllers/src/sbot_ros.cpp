@@ -322,7 +322,7 @@ void announceWait(const std::string& channel, const ros::Time& after, const ros:
   if (channel.empty())
     g->lockstep->leaving();
   else
-    g->lockstep->waitingFor(channel, after, g->speed_sent, g->speaker_sent);
+    g->lockstep->waitingFor(channel, after, g->speed_sent, g->speaker_sent, first);
 }
 
 bool ready(const char* fn) {

@@ -50,8 +50,10 @@ class LockstepClient {
 
   /// This controller now waits for a message on `topic` (under the robot) stamped later than `after`,
   /// having published `speed_commands` cmd_speed and `speaker_commands` speaker messages so far.
+  /// `new_subscription`: it subscribed to `topic` since its last call (the simulator then also holds
+  /// until its publisher knows the subscriber).
   void waitingFor(const std::string& topic, const ros::Time& after, std::uint64_t speed_commands,
-                  std::uint64_t speaker_commands = 0) {
+                  std::uint64_t speaker_commands, bool new_subscription) {
     if (!enabled_) return;
     sbot_msgs::ControllerSync m;
     m.robot = robot_;
@@ -59,10 +61,11 @@ class LockstepClient {
     m.after = after;
     m.speed_commands = speed_commands;
     m.speaker_commands = speaker_commands;
+    m.new_subscription = new_subscription;
     pub_.publish(m);
   }
   /// This controller stops: the simulator no longer holds for it.
-  void leaving() { waitingFor("", ros::Time(0), 0, 0); }
+  void leaving() { waitingFor("", ros::Time(0), 0, 0, false); }
 
  private:
   bool enabled_ = false;

@@ -112,7 +112,8 @@ LockstepGate::Hold LockstepGate::holdFor(const Waiter& w, ros::Time* published) 
   const auto r = robots_.find(s.robot);
   if (r != robots_.end() && (r->second.speed < s.speed_commands || r->second.speaker < s.speaker_commands))
     return Hold::Commands;
-  return *published > s.after ? Hold::Message : Hold::None;
+  if (*published > s.after) return Hold::Message;
+  return s.new_subscription && !publicationStamps().listened(s.robot, s.channel) ? Hold::Subscribing : Hold::None;
 }
 
 std::string LockstepGate::describe(const Waiter& w, Hold why, const ros::Time& published) const {
@@ -123,6 +124,9 @@ std::string LockstepGate::describe(const Waiter& w, Hold why, const ros::Time& p
     std::snprintf(text, sizeof(text), "commands in flight (cmd_speed %llu of %llu, speaker %llu of %llu received)",
                   static_cast<unsigned long long>(r.speed), static_cast<unsigned long long>(s.speed_commands),
                   static_cast<unsigned long long>(r.speaker), static_cast<unsigned long long>(s.speaker_commands));
+  } else if (why == Hold::Subscribing) {
+    std::snprintf(text, sizeof(text), "has subscribed to %s, but the simulator's publisher has not seen the "
+                  "subscription", s.channel.c_str());
   } else {
     std::snprintf(text, sizeof(text), "has %s stamped %.3f s to read (it last read %.3f s)", s.channel.c_str(),
                   published.toSec(), s.after.toSec());

@@ -11,6 +11,10 @@
 //   * holds while the simulator has published R/<channel> later than <after> (the controller has a
 //     message to read and will answer with a new sync), or fewer commands have arrived than the
 //     controller says it sent (ROS orders messages per topic, not across topics);
+//   * holds, for a sync marked new_subscription, until the node's publisher of R/<channel> knows the
+//     subscriber (publicationStamps().listened): topics are published only to subscribers, and the
+//     sync can overtake the new connection, so otherwise the first message's stamp would depend on
+//     how fast the connection completed (a phototaxis run differed by 12.5 mm about once in 8);
 //   * when it starts holding for a new message, tells the controller on R/lockstep_hold
 //     (sbot_msgs/LockstepHold) what it has published on each topic the controller reads up to then:
 //     the controller's getters wait for exactly that, whatever order the topics' messages arrive in;
@@ -70,7 +74,7 @@ class LockstepGate {
     ros::Publisher hold_pub;               ///< <robot>/lockstep_hold (latched)
     ros::Time hold_sent;                   ///< stamp of the last hold told
   };
-  enum class Hold { None, Commands, Message };
+  enum class Hold { None, Commands, Subscribing, Message };
 
   void onSync(const sbot_msgs::ControllerSync::ConstPtr& msg);
   /// Count the cmd_speed and speaker messages that reach `robot` and advertise its lockstep_hold

@@ -35,6 +35,15 @@ struct Tag {
   using type = T;
 };
 
+/// The rate channels whose publications are noted for the lock-step gate (publishNoted), as
+/// {subscriber-count key, topic}: the topics sbot.h getters read.
+const std::vector<std::pair<std::string, std::string>>& notedTopics() {
+  static const std::vector<std::pair<std::string, std::string>> t = {
+      {"proximity", "proximity"}, {"ground", "ground"},           {"light", "light"},        {"slope", "slope"},
+      {"gripper", "gripper/state"}, {"side_arm", "side_arm/state"}, {"battery", "battery"}, {"climate", "climate"}};
+  return t;
+}
+
 /// Every rate channel with its default [Hz] (sbot.h has no documented default; 10 Hz = SAMPLING_RATE_10).
 const std::vector<std::pair<std::string, double>>& channelDefaults() {
   static const std::vector<std::pair<std::string, double>> d = {
@@ -125,9 +134,14 @@ RobotModulesRos::RobotModulesRos(ros::NodeHandle nh, ros::NodeHandle pnh, const 
   set_side_arm_srv_ = nh_.advertiseService("set_side_arm", &RobotModulesRos::onSetSideArm, this);
   set_leds_srv_ = nh_.advertiseService("set_leds", &RobotModulesRos::onSetLeds, this);
   set_rate_srv_ = nh_.advertiseService("set_sampling_rate", &RobotModulesRos::onSetSamplingRate, this);
+  for (const auto& [key, topic] : notedTopics())
+    publicationStamps().watchSubscribers(name_, topic, [this, key = key] { return subs_[key] > 0; });
 }
 
-RobotModulesRos::~RobotModulesRos() { unbind(); }
+RobotModulesRos::~RobotModulesRos() {
+  for (const auto& [key, topic] : notedTopics()) publicationStamps().forgetSubscribers(name_, topic);
+  unbind();
+}
 
 void RobotModulesRos::bind(sbot::World& world, sn::Environment& env, sbot::Robot& robot) {
   unbind();

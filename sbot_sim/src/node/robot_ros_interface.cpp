@@ -41,6 +41,12 @@ RobotRosInterface::RobotRosInterface(ros::NodeHandle nh, sbot::Robot& robot, boo
   track_state_pub_ = nh_.advertise<sbot_msgs::TrackState>("track_state", kStateQueue);
   turret_state_pub_ = nh_.advertise<sbot_msgs::TurretState>("turret/state", kStateQueue);
   model_level_pub_ = nh_.advertise<sbot_msgs::ModelLevel>("model_level", 1, /*latch=*/true);
+  // The same tests publishState() makes (a level without a turret publishes no turret/state).
+  publicationStamps().watchSubscribers(name_, "ground_truth", [this] { return ground_truth_pub_.getNumSubscribers() > 0; });
+  publicationStamps().watchSubscribers(name_, "track_state", [this] { return track_state_pub_.getNumSubscribers() > 0; });
+  publicationStamps().watchSubscribers(name_, "turret/state", [this] {
+    return turret_state_pub_.getNumSubscribers() > 0 || !robot_ || robot_->description().turret.joint.empty();
+  });
   bind(robot);
   // Subscribers and services last: callbacks only run from the simulator's loop, but keep the
   // object complete before anything can reach it.
@@ -49,6 +55,10 @@ RobotRosInterface::RobotRosInterface(ros::NodeHandle nh, sbot::Robot& robot, boo
   cmd_vel_sub_ = nh_.subscribe("cmd_vel", 10, &RobotRosInterface::onCmdVel, this,
                                ros::TransportHints().tcpNoDelay());
   set_turret_srv_ = nh_.advertiseService("set_turret", &RobotRosInterface::onSetTurret, this);
+}
+
+RobotRosInterface::~RobotRosInterface() {
+  for (const char* topic : {"ground_truth", "track_state", "turret/state"}) publicationStamps().forgetSubscribers(name_, topic);
 }
 
 void RobotRosInterface::bind(sbot::Robot& robot) {

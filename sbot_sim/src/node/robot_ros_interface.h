@@ -37,6 +37,7 @@ class RobotRosInterface {
   /// `set_description_params` the interface also sets <robot name>/robot_description (the level's
   /// URDF) and <robot name>/tf_prefix for a robot_state_publisher started in that namespace.
   RobotRosInterface(ros::NodeHandle nh, sbot::Robot& robot, bool set_description_params = false);
+  ~RobotRosInterface();
   RobotRosInterface(const RobotRosInterface&) = delete;
   RobotRosInterface& operator=(const RobotRosInterface&) = delete;
 

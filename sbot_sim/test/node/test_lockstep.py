@@ -2,7 +2,8 @@
 """rostest (node_lockstep.test): the simulator's lock-step gate, with this test as sbot_0's
 controller (sbot_msgs/ControllerSync on /sim/controller_sync; the protocol is in
 sbot_sim/src/node/lockstep_gate.h). ~lockstep_controllers 1, ~lockstep_timeout 2 s, ground truth at
-50 Hz (every 0.02 s of simulated time)."""
+50 Hz (every 0.02 s of simulated time), slope at its default 10 Hz."""
+import math
 import os
 import sys
 import time
@@ -12,7 +13,7 @@ import rospy
 import rostest
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
-from sbot_msgs.msg import ControllerSync, LockstepHold, TrackSpeed
+from sbot_msgs.msg import ControllerSync, LockstepHold, Slope, TrackSpeed
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from node_test_common import Recorder  # noqa: E402
@@ -37,8 +38,9 @@ class TestLockstep(unittest.TestCase):
             while pub.get_num_connections() == 0 and time.monotonic() < deadline:
                 time.sleep(0.02)
 
-    def send_sync(self, robot, after, speed_commands):
-        m = ControllerSync(robot=robot, channel='ground_truth', speed_commands=speed_commands)
+    def send_sync(self, robot, after, speed_commands, channel='ground_truth', new_subscription=False):
+        m = ControllerSync(robot=robot, channel=channel, speed_commands=speed_commands,
+                           new_subscription=new_subscription)
         m.after = rospy.Time.from_sec(after)
         self.sync.publish(m)
 
@@ -78,6 +80,19 @@ class TestLockstep(unittest.TestCase):
         # 4. A controller that stays silent is dropped after ~lockstep_timeout (2 s wall) and the
         #    run goes on.
         self.assertGreater(self.clock_after(3.0), t2 + 0.1, 'a silent controller held the clock for good')
+
+        # 5. A controller about to read a topic for the first time (new_subscription) holds the clock
+        #    until the simulator's publisher has seen its subscription, however long the connection
+        #    takes (here: until we subscribe), so the first message is the first sample due after the
+        #    sync, not one that depends on the connection's speed.
+        self.send_sync('sbot_0', latest_clock(self.clock), 1, channel='slope', new_subscription=True)
+        t3 = self.clock_after(0.3)
+        self.assertAlmostEqual(self.clock_after(0.6), t3, places=6,
+                               msg='stepped before the publisher knew the new subscriber')
+        slope = Recorder('/sbot_0/slope', Slope)
+        first = slope.wait_for(lambda m: True, timeout=5.0, first=True).header.stamp.to_sec()
+        due = math.floor(t3 / 0.1 + 1e-6) * 0.1 + 0.1  # the next 10 Hz sampling instant after t3
+        self.assertAlmostEqual(first, due, places=6, msg='first slope sample at %.3f s, held at %.3f s' % (first, t3))
 
 
 if __name__ == '__main__':
