@@ -36,10 +36,26 @@ def launch_phototaxis(env, *args):
                             env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 
 
-def controller_pid(namespace):
-    """The pid of the sbot_phototaxis process roslaunch started in `namespace` (ROS_NAMESPACE)."""
+def parent_pid(pid):
+    with open("/proc/%s/stat" % pid) as f:
+        return int(f.read().rsplit(")", 1)[1].split()[1])
+
+
+def descends_from(pid, ancestor):
+    while pid > 1:
+        if pid == ancestor:
+            return True
+        pid = parent_pid(pid)
+    return False
+
+
+def controller_pid(namespace, launch_pid):
+    """The pid of the sbot_phototaxis process the roslaunch `launch_pid` started in `namespace`
+    (ROS_NAMESPACE); not one of another launch on the same machine (a second test suite)."""
     for pid in filter(str.isdigit, os.listdir("/proc")):
         try:
+            if not descends_from(int(pid), launch_pid):
+                continue
             with open("/proc/%s/cmdline" % pid, "rb") as f:
                 if b"sbot_phototaxis" not in f.read():
                     continue
@@ -131,7 +147,7 @@ class LockstepRepeatable(unittest.TestCase):
             deadline = time.monotonic() + 30
             pid = None
             while pid is None and time.monotonic() < deadline:
-                pid = controller_pid("/sbot_2")
+                pid = controller_pid("/sbot_2", launch.pid)
                 time.sleep(0.1)
             self.assertIsNotNone(pid, "no sbot_phototaxis process in /sbot_2")
             time.sleep(4.0)  # started, joined, running

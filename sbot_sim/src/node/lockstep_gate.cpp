@@ -39,7 +39,8 @@ LockstepGate::LockstepGate(ros::NodeHandle& nh, const LockstepParams& params, co
   last_waiting_log_ = SteadyClock::now();
 }
 
-void LockstepGate::onSync(const sbot_msgs::ControllerSync::ConstPtr& msg) {
+void LockstepGate::onSync(const ros::MessageEvent<const sbot_msgs::ControllerSync>& event) {
+  const sbot_msgs::ControllerSync::ConstPtr& msg = event.getConstMessage();
   const std::string& robot = msg->robot;
   const std::string refused = robot.empty() || robot.find('/') != std::string::npos
                                   ? "robot '" + robot + "' is not a robot namespace such as sbot_0"
@@ -64,7 +65,7 @@ void LockstepGate::onSync(const sbot_msgs::ControllerSync::ConstPtr& msg) {
              announced_.size(), params_.controllers);
   }
   watch(robot, msg->channel);
-  waiting_[robot] = Waiter{*msg, SteadyClock::now()};
+  waiting_[robot] = Waiter{*msg, event.getPublisherName(), SteadyClock::now()};
 }
 
 void LockstepGate::attachRobot(const std::string& robot) {
@@ -113,7 +114,8 @@ LockstepGate::Hold LockstepGate::holdFor(const Waiter& w, ros::Time* published) 
   if (r != robots_.end() && (r->second.speed < s.speed_commands || r->second.speaker < s.speaker_commands))
     return Hold::Commands;
   if (*published > s.after) return Hold::Message;
-  return s.new_subscription && !publicationStamps().listened(s.robot, s.channel) ? Hold::Subscribing : Hold::None;
+  return s.new_subscription && !publicationStamps().listened(s.robot, s.channel, w.node) ? Hold::Subscribing
+                                                                                        : Hold::None;
 }
 
 std::string LockstepGate::describe(const Waiter& w, Hold why, const ros::Time& published) const {
@@ -125,8 +127,8 @@ std::string LockstepGate::describe(const Waiter& w, Hold why, const ros::Time& p
                   static_cast<unsigned long long>(r.speed), static_cast<unsigned long long>(s.speed_commands),
                   static_cast<unsigned long long>(r.speaker), static_cast<unsigned long long>(s.speaker_commands));
   } else if (why == Hold::Subscribing) {
-    std::snprintf(text, sizeof(text), "has subscribed to %s, but the simulator's publisher has not seen the "
-                  "subscription", s.channel.c_str());
+    std::snprintf(text, sizeof(text), "has subscribed to %s, but the simulator's publisher has not seen %s "
+                  "connect", s.channel.c_str(), w.node.c_str());
   } else {
     std::snprintf(text, sizeof(text), "has %s stamped %.3f s to read (it last read %.3f s)", s.channel.c_str(),
                   published.toSec(), s.after.toSec());

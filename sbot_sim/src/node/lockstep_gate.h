@@ -11,10 +11,11 @@
 //   * holds while the simulator has published R/<channel> later than <after> (the controller has a
 //     message to read and will answer with a new sync), or fewer commands have arrived than the
 //     controller says it sent (ROS orders messages per topic, not across topics);
-//   * holds, for a sync marked new_subscription, until the node's publisher of R/<channel> knows the
-//     subscriber (publicationStamps().listened): topics are published only to subscribers, and the
-//     sync can overtake the new connection, so otherwise the first message's stamp would depend on
-//     how fast the connection completed (a phototaxis run differed by 12.5 mm about once in 8);
+//   * holds, for a sync marked new_subscription, until the node's publisher of R/<channel> has the
+//     controller (the sync's sender) among its subscribers (publicationStamps().listened): the sync
+//     can overtake the new connection, and topics are published only to subscribers, so otherwise
+//     the first message the controller gets would depend on how fast its connection completed (a
+//     phototaxis run differed by 12.5 mm about once in 8 full test suites);
 //   * when it starts holding for a new message, tells the controller on R/lockstep_hold
 //     (sbot_msgs/LockstepHold) what it has published on each topic the controller reads up to then:
 //     the controller's getters wait for exactly that, whatever order the topics' messages arrive in;
@@ -65,6 +66,7 @@ class LockstepGate {
  private:
   struct Waiter {
     sbot_msgs::ControllerSync sync;
+    std::string node;  ///< the controller's ROS name (the sync's publisher)
     std::chrono::steady_clock::time_point since;  ///< when this sync arrived
   };
   struct RobotState {
@@ -76,7 +78,7 @@ class LockstepGate {
   };
   enum class Hold { None, Commands, Subscribing, Message };
 
-  void onSync(const sbot_msgs::ControllerSync::ConstPtr& msg);
+  void onSync(const ros::MessageEvent<const sbot_msgs::ControllerSync>& event);
   /// Count the cmd_speed and speaker messages that reach `robot` and advertise its lockstep_hold
   /// (once per robot).
   void attachRobot(const std::string& robot);

@@ -1,7 +1,5 @@
 #include "modules_ros_interface.h"
 
-#include "publication_stamps.h"
-
 #include <algorithm>
 #include <cmath>
 
@@ -88,15 +86,13 @@ RobotModulesRos::RobotModulesRos(ros::NodeHandle nh, ros::NodeHandle pnh, const 
     rates_[ch].hz = hz;
   }
   constexpr uint32_t q = 10;
-  // Subscriber counts are kept by connect/disconnect callbacks: Publisher::getNumSubscribers() looks
-  // the topic up among all the node's publications (linear in their number: ~20 per robot), far too
-  // slow to ask every step for 100 robots.
+  // Subscribers are kept by connect/disconnect callbacks (SubscriberRoster): Publisher::getNumSubscribers()
+  // looks the topic up among all the node's publications (linear in their number: ~20 per robot),
+  // far too slow to ask every step for 100 robots.
   auto adv = [&](auto type_tag, const std::string& topic, const std::string& key, uint32_t queue, bool latch) {
     using M = typename decltype(type_tag)::type;
-    int* counter = &subs_[key];
-    return nh_.advertise<M>(topic, queue, [counter](const ros::SingleSubscriberPublisher&) { ++*counter; },
-                            [counter](const ros::SingleSubscriberPublisher&) { --*counter; }, ros::VoidConstPtr(),
-                            latch);
+    SubscriberRoster& roster = subs_[key];
+    return nh_.advertise<M>(topic, queue, roster.connected(), roster.disconnected(), ros::VoidConstPtr(), latch);
   };
   pubs_["proximity"] = adv(Tag<sbot_msgs::ProximityArray>(), "proximity", "proximity", q, false);
   for (int k = 0; k < sn::kProximitySensors; ++k)
@@ -135,7 +131,7 @@ RobotModulesRos::RobotModulesRos(ros::NodeHandle nh, ros::NodeHandle pnh, const 
   set_leds_srv_ = nh_.advertiseService("set_leds", &RobotModulesRos::onSetLeds, this);
   set_rate_srv_ = nh_.advertiseService("set_sampling_rate", &RobotModulesRos::onSetSamplingRate, this);
   for (const auto& [key, topic] : notedTopics())
-    publicationStamps().watchSubscribers(name_, topic, [this, key = key] { return subs_[key] > 0; });
+    publicationStamps().watchSubscribers(name_, topic, [this, key = key](const std::string& node) { return subs_[key].has(node); });
 }
 
 RobotModulesRos::~RobotModulesRos() {
@@ -193,7 +189,7 @@ bool RobotModulesRos::due(const std::string& channel, double t) {
   const double period = 1.0 / r.hz;
   r.next += period;
   if (r.next <= t) r.next = t + period;  // fell behind (rate raised, reset): restart the phase
-  return subs_[channel] > 0;
+  return subs_[channel].any();
 }
 
 bool RobotModulesRos::dueWithSingles(const std::string& channel, const std::string& single_prefix, int count,
@@ -201,7 +197,7 @@ bool RobotModulesRos::dueWithSingles(const std::string& channel, const std::stri
   const bool was_due = t + 1e-9 >= rates_[channel].next;
   any_single = false;
   if (was_due)
-    for (int k = 0; k < count; ++k) any_single = any_single || subs_[single_prefix + std::to_string(k)] > 0;
+    for (int k = 0; k < count; ++k) any_single = any_single || subs_[single_prefix + std::to_string(k)].any();
   return due(channel, t) || (was_due && any_single);
 }
 
@@ -240,7 +236,7 @@ void RobotModulesRos::update(double dt, double sim_time) {
       if (any_ir && suite_->proximity()) {
         const auto& resp = suite_->proximity()->response();
         for (int k = 0; k < sn::kProximitySensors; ++k) {
-          if (subs_["ir_" + std::to_string(k)] <= 0) continue;
+          if (!subs_["ir_" + std::to_string(k)].any()) continue;
           sensor_msgs::Range rg;
           rg.header = header(name_ + "/ir_" + std::to_string(k));
           rg.radiation_type = sensor_msgs::Range::INFRARED;
@@ -276,7 +272,7 @@ void RobotModulesRos::update(double dt, double sim_time) {
         const sn::LightSensorParams& lp = suite_->light()->params();
         constexpr double kLuxPerMcdPerCm2 = 10.0;  // 1e-3 cd / 1e-4 m^2
         for (int k = 0; k < sn::kLightSensors; ++k) {
-          if (subs_["light_" + std::to_string(k)] <= 0) continue;
+          if (!subs_["light_" + std::to_string(k)].any()) continue;
           sensor_msgs::Illuminance il;
           il.header = header(name_ + "/light_" + std::to_string(k));
           il.illuminance = all[k] * lp.unit * kLuxPerMcdPerCm2;

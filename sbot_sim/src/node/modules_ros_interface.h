@@ -48,6 +48,7 @@
 #include <sbot_msgs/SetSideArm.h>
 #include <std_msgs/Float64.h>
 
+#include "publication_stamps.h"
 #include "sbot_sim/core/actuators/gripper.h"
 #include "sbot_sim/core/actuators/side_arm.h"
 #include "sbot_sim/core/sensors/environment.h"
@@ -117,7 +118,7 @@ class RobotModulesRos {
   std::map<std::string, Rate> rates_;
   double next_any_ = 0;  ///< [s] earliest rates_[*].next
   std::map<std::string, ros::Publisher> pubs_;
-  std::map<std::string, int> subs_;  ///< subscriber count per channel / "ir_<k>" (connect callbacks)
+  std::map<std::string, SubscriberRoster> subs_;  ///< subscribers per channel / "ir_<k>" (connect callbacks)
   std::vector<ros::Publisher> ir_pubs_;     ///< proximity/ir_<k> (sensor_msgs/Range)
   std::vector<ros::Publisher> light_pubs_;  ///< light/sensor_<k> (sensor_msgs/Illuminance)
   ros::Subscriber leds_sub_, speaker_sub_;

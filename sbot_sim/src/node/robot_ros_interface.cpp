@@ -1,7 +1,5 @@
 #include "robot_ros_interface.h"
 
-#include "publication_stamps.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -36,16 +34,20 @@ RobotRosInterface::RobotRosInterface(ros::NodeHandle nh, sbot::Robot& robot, boo
     : nh_(nh, robot.name()), name_(robot.name()), set_description_params_(set_description_params) {
   base_frame_ = name_ + "/base_link";
   // Deep queues: as fast as possible, the simulator outpaces subscribers such as rosbag in bursts.
-  ground_truth_pub_ = nh_.advertise<nav_msgs::Odometry>("ground_truth", kStateQueue);
+  ground_truth_pub_ = nh_.advertise<nav_msgs::Odometry>("ground_truth", kStateQueue, ground_truth_subs_.connected(),
+                                                         ground_truth_subs_.disconnected());
   joint_states_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", kStateQueue);
-  track_state_pub_ = nh_.advertise<sbot_msgs::TrackState>("track_state", kStateQueue);
-  turret_state_pub_ = nh_.advertise<sbot_msgs::TurretState>("turret/state", kStateQueue);
+  track_state_pub_ = nh_.advertise<sbot_msgs::TrackState>("track_state", kStateQueue, track_state_subs_.connected(),
+                                                          track_state_subs_.disconnected());
+  turret_state_pub_ = nh_.advertise<sbot_msgs::TurretState>("turret/state", kStateQueue, turret_state_subs_.connected(),
+                                                            turret_state_subs_.disconnected());
   model_level_pub_ = nh_.advertise<sbot_msgs::ModelLevel>("model_level", 1, /*latch=*/true);
-  // The same tests publishState() makes (a level without a turret publishes no turret/state).
-  publicationStamps().watchSubscribers(name_, "ground_truth", [this] { return ground_truth_pub_.getNumSubscribers() > 0; });
-  publicationStamps().watchSubscribers(name_, "track_state", [this] { return track_state_pub_.getNumSubscribers() > 0; });
-  publicationStamps().watchSubscribers(name_, "turret/state", [this] {
-    return turret_state_pub_.getNumSubscribers() > 0 || !robot_ || robot_->description().turret.joint.empty();
+  // A node on the roster is connected, and publishState() publishes when anyone is (a level without
+  // a turret publishes no turret/state: nothing to wait for).
+  publicationStamps().watchSubscribers(name_, "ground_truth", [this](const std::string& n) { return ground_truth_subs_.has(n); });
+  publicationStamps().watchSubscribers(name_, "track_state", [this](const std::string& n) { return track_state_subs_.has(n); });
+  publicationStamps().watchSubscribers(name_, "turret/state", [this](const std::string& n) {
+    return turret_state_subs_.has(n) || !robot_ || robot_->description().turret.joint.empty();
   });
   bind(robot);
   // Subscribers and services last: callbacks only run from the simulator's loop, but keep the

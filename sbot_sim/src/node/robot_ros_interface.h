@@ -14,6 +14,7 @@
 #include <sbot_msgs/SetTurret.h>
 #include <sbot_msgs/TrackSpeed.h>
 
+#include "publication_stamps.h"
 #include "sbot_sim/core/robot.h"
 
 namespace sbot_node {
@@ -72,6 +73,8 @@ class RobotRosInterface {
 
   ros::Subscriber cmd_speed_sub_, cmd_vel_sub_;
   ros::Publisher ground_truth_pub_, joint_states_pub_, track_state_pub_, turret_state_pub_;
+  /// Who subscribes to the three topics controllers read (the lock-step gate asks).
+  SubscriberRoster ground_truth_subs_, track_state_subs_, turret_state_subs_;
   ros::Publisher model_level_pub_;
   ros::ServiceServer set_turret_srv_;
   WarnThrottle speed_clamp_warn_, vel_clamp_warn_, vel_invalid_warn_;

@@ -5,6 +5,7 @@ sbot_sim/src/node/lockstep_gate.h). ~lockstep_controllers 1, ~lockstep_timeout 2
 50 Hz (every 0.02 s of simulated time), slope at its default 10 Hz."""
 import math
 import os
+import subprocess
 import sys
 import time
 import unittest
@@ -82,15 +83,26 @@ class TestLockstep(unittest.TestCase):
         self.assertGreater(self.clock_after(3.0), t2 + 0.1, 'a silent controller held the clock for good')
 
         # 5. A controller about to read a topic for the first time (new_subscription) holds the clock
-        #    until the simulator's publisher has seen its subscription, however long the connection
-        #    takes (here: until we subscribe), so the first message is the first sample due after the
-        #    sync, not one that depends on the connection's speed.
-        self.send_sync('sbot_0', latest_clock(self.clock), 1, channel='slope', new_subscription=True)
-        t3 = self.clock_after(0.3)
-        self.assertAlmostEqual(self.clock_after(0.6), t3, places=6,
-                               msg='stepped before the publisher knew the new subscriber')
-        slope = Recorder('/sbot_0/slope', Slope)
-        first = slope.wait_for(lambda m: True, timeout=5.0, first=True).header.stamp.to_sec()
+        #    until the simulator's publisher has seen its own subscription, however long the
+        #    connection takes (here: until we subscribe) and whoever else listens already (here a
+        #    `rostopic hz`), so its first message is the first sample due after the sync, not one
+        #    that depends on the connection's speed. It waits for a sample after t + 0.15 s: a hold
+        #    before that is the new subscription's.
+        other = subprocess.Popen(['/usr/bin/rostopic', 'hz', '/sbot_0/slope'], stdout=subprocess.DEVNULL,
+                                 stderr=subprocess.DEVNULL)
+        try:
+            time.sleep(1.0)  # connected by now; the simulator publishes slope for it
+            after = latest_clock(self.clock) + 0.15
+            self.send_sync('sbot_0', after, 1, channel='slope', new_subscription=True)
+            t3 = self.clock_after(0.3)
+            self.assertLess(t3, after - 0.05, 'ran on to a sample after the sync instead of holding for the subscription')
+            self.assertAlmostEqual(self.clock_after(0.6), t3, places=6,
+                                   msg='stepped before the publisher knew the new subscriber')
+            slope = Recorder('/sbot_0/slope', Slope)
+            first = slope.wait_for(lambda m: True, timeout=5.0, first=True).header.stamp.to_sec()
+        finally:
+            other.terminate()
+            other.wait(timeout=10)
         due = math.floor(t3 / 0.1 + 1e-6) * 0.1 + 0.1  # the next 10 Hz sampling instant after t3
         self.assertAlmostEqual(first, due, places=6, msg='first slope sample at %.3f s, held at %.3f s' % (first, t3))
 
