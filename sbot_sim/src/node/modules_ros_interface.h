@@ -111,6 +111,8 @@ class RobotModulesRos {
   std::unique_ptr<sbot::actuators::SideArm> side_arm_;
   std::unique_ptr<sbot::sensors::RawCamera> raw_camera_;
   sbot::sensors::RawCameraParams camera_params_;
+  /// Subscribers per channel / "ir_<k>" (connect callbacks); before the publishers, which it outlives.
+  std::map<std::string, SubscriberRoster> subs_;
   // The image and its camera_info apart: a subscriber to camera_info alone (`rosbag record -a -x
   // '.*image_raw.*'`) must not make every robot ray-cast an image nobody takes.
   image_transport::Publisher camera_pub_;
@@ -118,7 +120,6 @@ class RobotModulesRos {
   std::map<std::string, Rate> rates_;
   double next_any_ = 0;  ///< [s] earliest rates_[*].next
   std::map<std::string, ros::Publisher> pubs_;
-  std::map<std::string, SubscriberRoster> subs_;  ///< subscribers per channel / "ir_<k>" (connect callbacks)
   std::vector<ros::Publisher> ir_pubs_;     ///< proximity/ir_<k> (sensor_msgs/Range)
   std::vector<ros::Publisher> light_pubs_;  ///< light/sensor_<k> (sensor_msgs/Illuminance)
   ros::Subscriber leds_sub_, speaker_sub_;
