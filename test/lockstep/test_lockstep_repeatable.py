@@ -87,6 +87,7 @@ def run_once(workdir, tag, lockstep=True):
                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
         wait_until(lambda: any(t == "/swarm/graph" for t, _ in graph.getSystemState()[1]), 20,
                    "rosbag record subscribing to /swarm/graph")
+        graph.handle("close")()  # its XML-RPC connection (else a ResourceWarning in the log)
         launch = launch_phototaxis(env, "lockstep:=%s" % ("true" if lockstep else "false"),
                                    "duration:=%g" % SIM_SECONDS, "real_time_factor:=0")
         out, _ = launch.communicate(timeout=180)
