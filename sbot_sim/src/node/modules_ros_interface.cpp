@@ -34,7 +34,7 @@ struct Tag {
 };
 
 /// The rate channels whose publications are noted for the lock-step gate (publishNoted), as
-/// {subscriber-count key, topic}: the topics sbot.h getters read.
+/// {subscriber-roster key, topic}: the topics sbot.h getters read.
 const std::vector<std::pair<std::string, std::string>>& notedTopics() {
   static const std::vector<std::pair<std::string, std::string>> t = {
       {"proximity", "proximity"}, {"ground", "ground"},           {"light", "light"},        {"slope", "slope"},
