@@ -25,7 +25,6 @@ namespace sbot {
 namespace validation {
 namespace {
 
-
 WorldConfig configFor(const RobotDescription& d, std::uint64_t seed) {
   WorldConfig c;
   c.step = d.recommended_step;

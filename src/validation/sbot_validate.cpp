@@ -70,8 +70,8 @@ struct Options {
 };
 
 const std::vector<std::string> kLevels{"fast", "simple", "medium", "detailed"};
-/// Every model level: the model facts cover Basic too (the seed's tables do not).
-const std::vector<std::string> kAllLevels{"fast", "simple", "basic", "medium", "detailed"};
+/// Every model level (the core's list): the model facts cover Basic too (the seed's tables do not).
+const std::vector<std::string>& kAllLevels = sbot::modelLevels();
 constexpr int kRtmRepeats = 5;  ///< Table 4.4: runs per RTM figure, the fastest reported
 /// The built-in sections a tables file can place in its report (experiments that are not cells of
 /// one trial kind), the paragraphs a table can have printed under it, and the group the two-robot

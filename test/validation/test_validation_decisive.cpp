@@ -16,6 +16,7 @@
 
 #include "experiments.h"
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/robot_description.h"
 #include "mismatch_reasons.h"
 
 namespace v = sbot::validation;
@@ -71,7 +72,7 @@ TEST(ValidationCompatibility, EveryLevelsConnectedPairStandsAtItsScaledDistance)
   // Seed 2.1.3: two s-bots connected by the front gripper are the same distance apart at every
   // level (0.147 m centre to centre; the half-size Fast pair half of it), standing and after
   // reversing together (the link holds).
-  const std::vector<std::string> levels{"fast", "simple", "basic", "medium", "detailed"};
+  const std::vector<std::string>& levels = sbot::modelLevels();
   const auto r = v::runParallel(static_cast<int>(levels.size()), 2, [&](int i) { return v::connectedPairTrial(levels[i]); });
   for (std::size_t i = 0; i < levels.size(); ++i) {
     ASSERT_NE(r[i].label, "error") << levels[i];
