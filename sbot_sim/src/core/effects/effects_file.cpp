@@ -11,6 +11,7 @@
 
 #include "sbot_sim/core/effects/effect_registry.h"
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/output_files.h"
 
 namespace sbot {
 namespace {
@@ -147,9 +148,7 @@ std::string effectsToYaml(const std::vector<EffectConfig>& configs, const std::s
 }
 
 void writeEffectsFile(const std::string& path, const std::vector<EffectConfig>& configs, const std::string& header) {
-  std::ofstream out(path);
-  if (!out) throw ConfigError(path, "", "cannot write effects file");
-  out << effectsToYaml(configs, header);
+  writeTextFile(path, effectsToYaml(configs, header));
 }
 
 }  // namespace sbot

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <limits>
 #include <memory>
@@ -13,6 +12,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/output_files.h"
 #include "sbot_sim/core/robot.h"
 #include "sbot_sim/core/robot_description.h"
 
@@ -149,8 +149,7 @@ double IrLookupTable::lookup(double gap, double bearing) const {
 }
 
 void IrLookupTable::save(const std::string& path) const {
-  std::ofstream f(path);
-  if (!f) throw ConfigError(path, "", "cannot write the IR look-up table");
+  OutputFile f(path);
   f << std::setprecision(10);
   f << "# ir_lut.yaml -- GENERATED sample-based IR proximity table (seed 2.2.6 item 1), used by the\n"
        "# Fast and Simple levels (sidecar extra ir_model: lut). Do not edit by hand. Regenerate with\n"
@@ -191,7 +190,7 @@ void IrLookupTable::save(const std::string& path) const {
     list(row, 2);
     f << "\n";
   }
-  if (!f) throw ConfigError(path, "", "error while writing the IR look-up table");
+  f.commit();
 }
 
 IrLookupTable IrLookupTable::load(const std::string& path) {
