@@ -13,6 +13,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "sbot_sim/core/output_files.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/scenario.h"
 #include "sbot_sim/core/world.h"  // positionProblem
@@ -557,8 +558,7 @@ std::string fmt(double v, int prec = 7) {
 }
 
 void writeRunCsv(const Run& run, const std::string& path) {
-  std::ofstream out(path);
-  if (!out) throw DatasetError(path, 0, 0, "", "cannot write");
+  OutputFile out(path);
   std::vector<std::string> cols;
   for (const auto& [c, s] : run.channels) cols.push_back(c);
   // Stable, readable order: pose, speeds, torques, tilt, then sensors.
@@ -628,12 +628,13 @@ void writeRunCsv(const Run& run, const std::string& path) {
       out << "\n";
     }
   }
+  out.commit();
 }
 
 }  // namespace
 
 void writeDataset(const Dataset& ds, const std::string& dir) {
-  ::mkdir(dir.c_str(), 0755);
+  makeOutputDirectory(dir);
   YAML::Emitter e;
   e.SetDoublePrecision(10);
   e << YAML::BeginMap;
@@ -697,9 +698,7 @@ void writeDataset(const Dataset& ds, const std::string& dir) {
   }
   e << YAML::EndSeq;
   e << YAML::EndMap;
-  std::ofstream out(dir + "/dataset.yaml");
-  if (!out) throw DatasetError(dir + "/dataset.yaml", 0, 0, "", "cannot write");
-  out << "# sbot-dataset/1 (see docs/calibration.md)\n" << e.c_str() << "\n";
+  writeTextFile(dir + "/dataset.yaml", std::string("# sbot-dataset/1 (see docs/calibration.md)\n") + e.c_str() + "\n");
   for (const auto& r : ds.runs) writeRunCsv(r, dir + "/" + (r.file.empty() ? r.name + ".csv" : r.file));
 }
 

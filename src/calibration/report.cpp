@@ -1,15 +1,14 @@
 #include "calibration/report.h"
 
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
 #include <set>
-#include <fstream>
 #include <iomanip>
 #include <sstream>
+
+#include "sbot_sim/core/output_files.h"
 
 namespace sbot::calib {
 namespace {
@@ -17,17 +16,6 @@ namespace {
 /// NRMSE fit [%] = 100 (1 - |y - yhat| / |y - mean(y)|) from the two sums of squares; NaN for a flat y.
 double nrmseFit(double ss_residual, double ss_measured) {
   return ss_measured > 0 ? 100 * (1 - std::sqrt(ss_residual / ss_measured)) : std::numeric_limits<double>::quiet_NaN();
-}
-
-void mkdirs(const std::string& path) {
-  std::string cur;
-  std::stringstream ss(path);
-  if (!path.empty() && path[0] == '/') cur = "/";
-  for (std::string part; std::getline(ss, part, '/');) {
-    if (part.empty()) continue;
-    cur += part + "/";
-    ::mkdir(cur.c_str(), 0755);
-  }
 }
 
 std::string f(double v, int prec = 4) {
@@ -141,8 +129,8 @@ VariantSummary summarise(const Dataset& ds, const Evaluation& ev, const std::str
 std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
                                                const std::vector<std::pair<std::string, ModelSpec>>& variants,
                                                const CompareOptions& opt, WorkerPool& pool) {
-  mkdirs(opt.out_dir + "/data");
-  mkdirs(opt.out_dir + "/plots");
+  makeOutputDirectory(opt.out_dir + "/data");
+  makeOutputDirectory(opt.out_dir + "/plots");
   EvalOptions eo = opt.eval;
   eo.replay.keep_trace = true;
   std::vector<VariantSummary> sums;
@@ -152,10 +140,10 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
     sums.push_back(summarise(ds, ev, variants[vi].first, variants[vi].second));
     // Per-sample data and traces for the plots.
     const std::string vdir = opt.out_dir + "/data/v" + std::to_string(vi);
-    mkdirs(vdir);
+    makeOutputDirectory(vdir);
     for (const auto& rr : ev.runs) {
       const Run& run = ds.runs[rr.run];
-      std::ofstream o(vdir + "/" + run.name + ".csv");
+      OutputFile o(vdir + "/" + run.name + ".csv");
       o << "channel,t,measured,predicted,residual,normalised,valid,v,w,accel,contact,yaw,distance,incidence,surface\n";
       o << std::setprecision(9);
       for (std::size_t ci = 0; ci < rr.channels.size(); ++ci) {
@@ -183,15 +171,17 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
             << (sit != rr.prediction.surface.end() && idx < sit->second.size() ? sit->second[idx] : "") << "\n";
         }
       }
+      o.commit();
       const Trace& tr = rr.prediction.trace;
       if (!tr.t.empty()) {
-        std::ofstream t(vdir + "/" + run.name + "_trace.csv");
+        OutputFile t(vdir + "/" + run.name + "_trace.csv");
         t << "t,x,y,yaw,v,w,cmd_left,cmd_right,speed_left,speed_right,contact\n" << std::setprecision(8);
         for (std::size_t i = 0; i < tr.t.size(); i += 3)
           t << tr.t[i] << "," << tr.x[i] << "," << tr.y[i] << "," << tr.yaw[i] << "," << tr.v[i] << "," << tr.w[i]
             << "," << tr.cmd_left[i] << "," << tr.cmd_right[i] << ","
             << (i < tr.speed_left.size() ? tr.speed_left[i] : 0) << ","
             << (i < tr.speed_right.size() ? tr.speed_right[i] : 0) << "," << static_cast<int>(tr.contact[i]) << "\n";
+        t.commit();
       }
     }
     evals.push_back(std::move(ev));
@@ -199,7 +189,7 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
 
   // summary.json for plot_report.py
   {
-    std::ofstream j(opt.out_dir + "/summary.json");
+    OutputFile j(opt.out_dir + "/summary.json");
     j << std::setprecision(9) << "{\n  \"dataset\": \"" << jsonEscape(ds.name) << "\",\n  \"window\": " << opt.window
       << ",\n  \"runs\": [";
     for (std::size_t i = 0; i < ds.runs.size(); ++i)
@@ -219,10 +209,11 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
       j << "}}" << (vi + 1 < sums.size() ? "," : "") << "\n";
     }
     j << "  ]\n}\n";
+    j.commit();
   }
 
   // The Markdown report.
-  std::ofstream md(opt.out_dir + "/report.md");
+  OutputFile md(opt.out_dir + "/report.md");
   md << "# Model vs measurements: " << ds.name << "\n\n";
   md << "Dataset `" << ds.yaml_path << "` (" << ds.runs.size() << " runs, " << ds.sampleCount()
      << " measured samples), model level **" << (variants.empty() ? ds.robot : variants.front().second.level)
@@ -326,13 +317,14 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
      << "### Parity (measured against simulated)\n\n![parity](plots/parity.png)\n\n";
   if (sensors)
     md << "### Sensors: residual against distance, incidence angle and surface\n\n![sensor residuals](plots/sensor_features.png)\n\n";
-  md.close();
+  md.commit();
 
   if (opt.plots) {
     const std::string cmd = "/usr/bin/python3 '" + scriptDirectory() + "/plot_report.py' '" + opt.out_dir + "'";
     if (std::system(cmd.c_str()) != 0) {
-      std::ofstream app(opt.out_dir + "/report.md", std::ios::app);
+      OutputFile app(opt.out_dir + "/report.md", std::ios::app);
       app << "\n> plots could not be drawn (" << cmd << " failed)\n";
+      app.commit();
     }
   }
   return sums;

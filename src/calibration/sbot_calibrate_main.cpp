@@ -10,11 +10,12 @@
 //   sbot_calibrate effects  (list the effects library)
 //   common: --jobs N (worker processes, default: all cores), --quiet; compare/diagnose/fit also
 //           --solver quickstep|exact (replaces the dataset's world stepper)
+// Output places (--out, --write-effects) are created and checked before the work: a fit or a
+// diagnosis runs for minutes, and its result must not be lost to an unwritable path at the end.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -28,6 +29,7 @@
 #include "calibration/sweep.h"
 #include "sbot_sim/core/effects/effect_registry.h"
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/output_files.h"
 
 using namespace sbot;
 using namespace sbot::calib;
@@ -115,6 +117,26 @@ void checkOptions(const Args& a) {
   for (const auto& k : a.flags) refuseUnknownOption(a.cmd, k);
 }
 
+/// compare's report directory when --out is not given.
+const char* const kDefaultReportDir = "calibration_report";
+
+/// The command's output places exist and can be written (output_files.h), checked before its work;
+/// else an OutputError that names the option.
+void checkOutputs(const Args& a) {
+  auto check = [&](const std::string& option, bool directory, const std::string& path) {
+    try {
+      if (directory) makeOutputDirectory(path);
+      else checkOutputFile(path);
+    } catch (const OutputError& e) {
+      throw OutputError("--" + option + ": " + e.what());
+    }
+  };
+  if (a.cmd == "compare") check("out", true, a.get("out", kDefaultReportDir));
+  if (a.cmd == "generate" && a.has("out")) check("out", true, a.get("out"));
+  if ((a.cmd == "fit" || a.cmd == "sweep") && a.has("out")) check("out", false, a.get("out"));
+  if (a.cmd == "diagnose" && a.has("write-effects")) check("write-effects", false, a.get("write-effects"));
+}
+
 std::string pct(double v) {
   std::ostringstream o;
   o << std::fixed << std::setprecision(1) << v << " %";
@@ -183,7 +205,7 @@ int cmdCompare(const Args& a) {
     }
   }
   CompareOptions co;
-  co.out_dir = a.get("out", "calibration_report");
+  co.out_dir = a.get("out", kDefaultReportDir);
   co.plots = !a.has("no-plots");
   co.eval.replay.align = !a.has("no-align");
   const auto sums = writeCompareReport(ds, variants, co, WorkerPool::global());
@@ -329,6 +351,7 @@ int main(int argc, char** argv) {
       return a.cmd.empty() ? 2 : 0;
     }
     checkOptions(a);
+    checkOutputs(a);
     if (a.has("jobs")) WorkerPool::setGlobalSize(static_cast<int>(a.num("jobs", 0)));
     if (a.cmd == "effects") return cmdEffects();
     if (a.cmd == "compare") return cmdCompare(a);

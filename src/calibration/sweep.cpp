@@ -2,13 +2,13 @@
 
 #include "calibration/codec.h"
 #include "calibration/effect_list.h"
+#include "sbot_sim/core/output_files.h"
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iomanip>
 #include <mutex>
 #include <sstream>
@@ -354,10 +354,7 @@ int runSweepCommand(const std::multimap<std::string, std::string>& opts, const s
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const std::string md = sweepMarkdown(res, o, secs);
   std::printf("%s", md.c_str());
-  if (opts.count("out")) {
-    std::ofstream f(get("out", ""));
-    f << md;
-  }
+  if (opts.count("out")) writeTextFile(get("out", ""), md);
   return 0;
 }
 

@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
-#include <fstream>
 #include <memory>
 #include <random>
 #include <stdexcept>
@@ -12,6 +11,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "sbot_sim/core/actuators/gripper.h"
+#include "sbot_sim/core/output_files.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/swarm/level_policy.h"
 #include "sbot_sim/core/world.h"
@@ -69,10 +69,10 @@ RunResult runCourse(const CourseRunConfig& o, const sbot::Scenario& sc, const Ro
   auto gripper = std::make_unique<sbot::actuators::FrontGripper>(world, robot);
   gripper->setElevation(0);
 
-  std::ofstream path;
+  std::unique_ptr<sbot::OutputFile> path;  // the run's path log, when asked for
   if (!o.path_csv.empty()) {
-    path.open(o.path_csv);
-    path << "t,x,y,z,yaw,level\n";
+    path = std::make_unique<sbot::OutputFile>(o.path_csv);
+    *path << "t,x,y,z,yaw,level\n";
   }
   const double dt = wc.step;
   const int control_every = std::max(1, static_cast<int>(std::round(0.1 / dt)));
@@ -96,8 +96,8 @@ RunResult runCourse(const CourseRunConfig& o, const sbot::Scenario& sc, const Ro
       }
     }
     if (s % control_every == 0) {
-      if (path.is_open()) path << t << "," << p.position.x() << "," << p.position.y() << "," << p.position.z() << "," << yaw << ","
-           << level << "\n";
+      if (path) *path << t << "," << p.position.x() << "," << p.position.y() << "," << p.position.z() << "," << yaw << ","
+                      << level << "\n";
       // Finished? Past the last waypoint's perpendicular line.
       const sbot::Vec3 a = route.waypoints[route.waypoints.size() - 2], b = route.waypoints.back();
       const sbot::Vec3 pos(p.position.x(), p.position.y(), 0);
@@ -158,6 +158,7 @@ RunResult runCourse(const CourseRunConfig& o, const sbot::Scenario& sc, const Ro
   const sbot::Pose f = robot.basePose();
   res.x = f.position.x();
   res.y = f.position.y();
+  if (path) path->commit();
   return res;
 }
 

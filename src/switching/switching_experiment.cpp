@@ -45,6 +45,7 @@
 
 #include "course_run.h"
 #include "sbot_sim/tools/cli_args.h"
+#include "sbot_sim/core/output_files.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/scenario.h"
 #include "sbot_sim/core/swarm/level_policy.h"
@@ -71,7 +72,7 @@ struct Options {
 void runMode(const Options& o, const std::string& mode) {
   const sbot::Scenario sc = sbot::loadScenario(o.scenario);
   const Route route = loadRoute(o.route);
-  std::ofstream sum(o.out + "/" + mode + "_summary.csv");
+  sbot::OutputFile sum(o.out + "/" + mode + "_summary.csv");
   sum << "run,reached,end,sim_s,wall_s,cpu_s,final_x,final_y,switches,basic_s,medium_s,detailed_s\n";
   for (int k = 0; k < o.runs; ++k) {
     CourseRunConfig rc = o.course;
@@ -88,6 +89,7 @@ void runMode(const Options& o, const std::string& mode) {
                 lt("basic"), lt("medium"), lt("detailed"));
     std::fflush(stdout);
   }
+  sum.commit();
 }
 
 struct ModeStats {
@@ -148,7 +150,12 @@ int main(int argc, char** argv) {
     const auto dot = o.route.rfind(".yaml");
     o.route = (dot == std::string::npos ? o.route : o.route.substr(0, dot)) + ".route.yaml";
   }
-  std::system(("mkdir -p '" + o.out + "'").c_str());
+  try {  // before any run: the results would be lost at the end
+    sbot::makeOutputDirectory(o.out);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "switching_experiment: --out: %s\n", e.what());
+    return 2;
+  }
   try {
     sbot::loadScenario(o.scenario);
     loadRoute(o.route);
@@ -227,6 +234,11 @@ int main(int argc, char** argv) {
     rep << line;
   }
   std::printf("%s", rep.str().c_str());
-  std::ofstream(o.out + "/summary.txt") << rep.str();
+  try {
+    sbot::writeTextFile(o.out + "/summary.txt", rep.str());
+  } catch (const std::exception& e) {  // the summary is on stdout above
+    std::fprintf(stderr, "switching_experiment: the summary was not saved (it is printed above): %s\n", e.what());
+    return 2;
+  }
   return 0;
 }

@@ -12,7 +12,9 @@
 // as is an unreadable --heightmap when fig4.4 is wanted, and a tables file with any error).
 // --quick: 3 trials per cell and 4 runs per roughness (minutes instead of tens of minutes).
 // Exit status: 0 when every cell of the file's required groups (the seed's: the hardware cells of
-// Tables 4.1-4.3) matches, 1 otherwise, 2 on bad usage.
+// Tables 4.1-4.3) matches, 1 otherwise, 2 on bad usage or when the report cannot be saved (--out is
+// created with its parents and checked before any trial; a report that fails to save at the end is
+// still printed on stdout).
 //
 //   sbot_validate [--trace] [--index N] [--speed UNITS] --trial KIND LEVEL PARAM    one trial, printed
 //     (tuning aid); --trace prints the robot's state every 0.1 s (pose, attitude, wheel load, track
@@ -21,7 +23,6 @@
 // KIND: gap, step, stepb, slope, slopeb, uphill, downhill, rough, rtm, speed (PARAM: m, m, m, deg,
 // deg, rad, rad, HR in cm, simulated s, setSpeed units of the compatibility check; ranges in
 // experimentKinds(), experiments.h).
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -30,7 +31,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <functional>
 #include <iomanip>
 #include <map>
@@ -48,6 +48,7 @@
 #include "reference_tables.h"
 #include "sbot_sim/tools/cli_args.h"
 #include "two_sbots_trials.h"
+#include "sbot_sim/core/output_files.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/terrain.h"
 #include "sbot_sim/core/world_config.h"
@@ -219,7 +220,7 @@ void plotFig44(const std::string& path, const std::vector<double>& hrs,
   }
   cv::putText(img, "dots: mean", cv::Point(W - R + 20, T + 140), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0), 1);
   cv::putText(img, "bars: min-max", cv::Point(W - R + 20, T + 158), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0), 1);
-  cv::imwrite(path, img);
+  if (!cv::imwrite(path, img)) throw sbot::OutputError("cannot write '" + path + "'");
 }
 
 /// Table 4.4's "what limits it": the step time of one s-bot per level split by phase
@@ -508,7 +509,12 @@ void writeFig44(std::ostream& md, const Options& o) {
     }
     md << " |\n";
   }
-  plotFig44(o.out + "/fig4_4.png", hrs, data);
+  try {  // the numbers above are the result; a plot that cannot be saved is said, not fatal
+    plotFig44(o.out + "/fig4_4.png", hrs, data);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sbot_validate: Figure 4.4's plot: %s\n", e.what());
+    md << "\n(The plot could not be saved: " << e.what() << ".)\n";
+  }
   md << "\nSeed's reading: Medium follows Detailed; Simple and Fast lose their course on minimally rough "
         "terrain (mean distance falls from HR 2 on).\n\n";
 }
@@ -689,7 +695,12 @@ int main(int argc, char** argv) {
   }
   for (const std::string& level : kAllLevels)  // before any work: every trial of that level would fail on it
     sbot_tools::requireLevel("sbot_validate", "model description of level '" + level + "' (or $SBOT_DESCRIPTION_DIR)", level);
-  mkdir(o.out.c_str(), 0755);
+  try {  // before any work: a report that cannot be saved would be found out only at the end
+    sbot::makeOutputDirectory(o.out);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sbot_validate: --out: %s\n", e.what());
+    return 2;
+  }
 
   RtmRuns rtm;
   if (want("4.4")) rtm = measureRtm(o);
@@ -745,8 +756,13 @@ int main(int argc, char** argv) {
   md << "\nReference tables: `" << tables.source << "`. Each mismatch is explained under its table (from `"
      << reasons.source() << "`); the full analysis, with what was tried, is *Why cells do not match* in "
         "`src/validation/README.md`.\n";
-  std::ofstream(o.out + "/report.md") << md.str();
-  progress("wrote " + o.out + "/report.md (" + counts + ")");
   std::printf("%s", md.str().c_str());
+  try {
+    sbot::writeTextFile(o.out + "/report.md", md.str());
+  } catch (const std::exception& e) {  // the report is on stdout above: say so, and fail the run
+    std::fprintf(stderr, "sbot_validate: the report was not saved (it is printed above): %s\n", e.what());
+    return 2;
+  }
+  progress("wrote " + o.out + "/report.md (" + counts + ")");
   return required_match ? 0 : 1;
 }

@@ -3,6 +3,7 @@
 // model), and so are bad values of the ones it does take.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <string>
 
 #include "../common/run_process.h"
@@ -33,6 +34,25 @@ TEST(Cli, ABadSolverIsRefusedByName) {
   const Outcome o = run("compare " + kExample + " --solver fast --no-plots --out " + testing::TempDir() + "cli_solver");
   EXPECT_EQ(o.status, 1) << o.output;
   EXPECT_NE(o.output.find("--solver expects quickstep or exact, got 'fast'"), std::string::npos) << o.output;
+}
+
+// An output place that cannot be written is refused before the work (a fit or a diagnosis runs for
+// minutes): compare and fit used to compute, then print "report: DIR/report.md" or lose the fitted
+// effects file, with exit status 0.
+TEST(Cli, AnOutputPlaceThatCannotBeWrittenIsRefusedBeforeTheWork) {
+  const std::string dir = testing::TempDir() + "cli_out/";
+  std::system(("rm -rf " + dir + " && mkdir -p " + dir + " && touch " + dir + "plain").c_str());
+  auto refused = [](const Outcome& o, const std::string& message) {
+    EXPECT_EQ(o.status, 1) << o.output;
+    EXPECT_NE(o.output.find("sbot_calibrate: " + message), std::string::npos) << o.output;
+    EXPECT_EQ(o.output.find("nRMS"), std::string::npos) << "nothing was computed: " << o.output;
+  };
+  refused(run("compare " + kExample + " --no-plots --out /proc/sbot_no_such_place"),
+          "--out: cannot create directory '/proc/sbot_no_such_place': No such file or directory");
+  refused(run("fit " + kExample + " --effect speed_scale --out " + dir + "plain/fitted.yaml"),
+          "--out: cannot create directory '" + dir + "plain': '" + dir + "plain' exists and is not a directory");
+  refused(run("diagnose " + kExample + " --write-effects " + dir), "--write-effects: cannot write '" + dir + "': it is a directory");
+  refused(run("generate --out " + dir + "plain"), "--out: cannot create directory '" + dir + "plain'");
 }
 
 TEST(Cli, TheOptionsItTakesAreAccepted) {

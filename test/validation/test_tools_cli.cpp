@@ -202,6 +202,33 @@ TEST(ToolsCli, AnUnreadableModelDescriptionIsRefusedBeforeAnyRun) {
       << o.output;
 }
 
+// An output place that cannot be written (output_files.h): sbot_validate made its directory without
+// looking at the result, ran every trial and then said "wrote DIR/report.md" with no file there.
+// Now it is refused before the first trial, with the directory and the system's reason; a missing
+// parent is created.
+TEST(ToolsCli, AnOutputPlaceThatCannotBeWrittenIsRefusedBeforeAnyRun) {
+  const std::string dir = testing::TempDir() + "cli_out/";
+  std::system(("rm -rf " + dir + " && mkdir -p " + dir + " && touch " + dir + "plain").c_str());
+  Outcome o = run("sbot_validate", "--out /proc/sbot_no_such_place/report --only 4.2 --trials 1 --jobs 1");
+  EXPECT_EQ(o.status, 2) << o.output;
+  EXPECT_NE(o.output.find("sbot_validate: --out: cannot create directory '/proc/sbot_no_such_place' (for "
+                          "'/proc/sbot_no_such_place/report'): No such file or directory"),
+            std::string::npos)
+      << o.output;
+  EXPECT_EQ(o.output.find("Table 4.2"), std::string::npos) << "no trial runs: " << o.output;
+  expectRefused("sbot_validate", "--out " + dir + "plain/report --only 4.2",
+                "--out: cannot create directory '" + dir + "plain/report': '" + dir + "plain' exists and is not a directory");
+  expectRefused("switching_experiment", "--runs 1 --out " + dir + "plain",
+                "switching_experiment: --out: cannot create directory '" + dir + "plain'");
+  o = run("sbot_validate", "--out " + dir + "new/nested --only 4.2 --trials 1 --jobs 1");
+  EXPECT_EQ(o.status, 1) << "the 55 mm cell is a known mismatch: " << o.output;
+  EXPECT_NE(o.output.find("wrote " + dir + "new/nested/report.md"), std::string::npos) << o.output;
+  std::ifstream report(dir + "new/nested/report.md");
+  std::string first;
+  std::getline(report, first);
+  EXPECT_EQ(first, "# swarmbot3d validation report");
+}
+
 TEST(ToolsCli, AValidTrialRuns) {
   const Outcome o = run("sbot_validate", "--trial step detailed 0.010");
   EXPECT_EQ(o.status, 0) << o.output;
