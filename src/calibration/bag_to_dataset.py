@@ -172,7 +172,19 @@ def main(argv=None):
         if not rows:
             raise SystemExit("%s: none of the topics %s is in the bag" % (bag, sorted(t for t in topics.values() if t)))
         imported.append((bag, rows, pose, missing))
-    os.makedirs(a.out, exist_ok=True)
+    try:
+        os.makedirs(a.out, exist_ok=True)
+    except OSError as error:  # e.g. a file in the way, or a read-only place: name it, no traceback
+        raise SystemExit("bag_to_dataset: cannot create the dataset directory %s: %s" % (a.out, error.strerror))
+    try:
+        write_dataset(a, ds, imported, yaml_path)
+    except OSError as error:
+        raise SystemExit("bag_to_dataset: cannot write %s: %s" % (error.filename or a.out, error.strerror))
+    return 0
+
+
+def write_dataset(a, ds, imported, yaml_path):
+    """The runs' CSVs and dataset.yaml (appending to `ds`); OSError when a file cannot be written."""
     names = {r["name"] for r in ds["runs"]}
     for bag, rows, pose, missing in imported:
         name = a.run_name or os.path.splitext(os.path.basename(bag))[0]
@@ -194,7 +206,6 @@ def main(argv=None):
         f.write("# sbot-dataset/1 (see docs/calibration.md)\n")
         yaml.safe_dump(ds, f, default_flow_style=None, sort_keys=False)
     sys.stdout.write("wrote %s (%d runs)\n" % (yaml_path, len(ds["runs"])))
-    return 0
 
 
 if __name__ == "__main__":

@@ -140,6 +140,16 @@ class BagImporterTest(unittest.TestCase):
         self.assertIn("cannot read %s" % corrupt, str(e.exception))
         self.assertFalse(os.path.exists(out), "the good bag's CSV was written without a dataset.yaml")
 
+    def test_an_output_place_that_cannot_be_made_is_named(self):
+        good = os.path.join(self.tmp, "good_for_out.bag")
+        self.write_bag("straight_20", good)
+        plain = os.path.join(self.tmp, "plain_file")
+        open(plain, "w").close()
+        with self.assertRaises(SystemExit) as e:
+            bag_to_dataset.main([os.path.join(plain, "dataset"), good, "--tracker-topic", "/tracker/sbot_0"])
+        self.assertIn("cannot create the dataset directory %s" % os.path.join(plain, "dataset"), str(e.exception))
+        self.assertIn("Not a directory", str(e.exception))
+
 
 if __name__ == "__main__":
     unittest.main(argv=sys.argv[:1])
