@@ -145,6 +145,19 @@ int main(int argc, char** argv) {
       return a == "--help" ? 0 : 2;
     }
   }
+  // Before any run: an unknown mode found in the fork loop used to leave the modes before it running.
+  const auto& levels = sbot::modelLevels();
+  for (const auto& mode : o.modes) {
+    if (mode == "switching" || std::find(levels.begin(), levels.end(), mode) != levels.end()) continue;
+    std::string known = "switching";
+    for (const auto& l : levels) known += ", " + l;
+    std::fprintf(stderr, "switching_experiment: --modes: unknown mode '%s' (modes: %s)\n", mode.c_str(), known.c_str());
+    return 2;
+  }
+  if (o.modes.empty()) {
+    std::fprintf(stderr, "switching_experiment: --modes: no mode given\n");
+    return 2;
+  }
   if (o.route.empty()) {
     o.route = o.scenario;
     const auto dot = o.route.rfind(".yaml");
@@ -166,11 +179,6 @@ int main(int argc, char** argv) {
   // One child process per mode; at most `jobs` at a time.
   std::vector<pid_t> running;
   for (const auto& mode : o.modes) {
-    const auto& levels = sbot::modelLevels();
-    if (mode != "switching" && std::find(levels.begin(), levels.end(), mode) == levels.end()) {
-      std::fprintf(stderr, "unknown mode '%s'\n", mode.c_str());
-      return 2;
-    }
     if (static_cast<int>(running.size()) >= std::max(1, o.jobs)) {
       waitpid(running.front(), nullptr, 0);
       running.erase(running.begin());

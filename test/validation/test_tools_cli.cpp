@@ -65,6 +65,15 @@ TEST(ToolsCli, AnOptionWithoutItsValueIsRefusedByName) {
   expectRefused("two_sbots", "--level", "two_sbots: --level needs a value");
 }
 
+// An unknown switching mode is refused before any mode's run starts: it used to be found in the loop
+// that starts them, after "detailed" had been started, and without the tool's name.
+TEST(ToolsCli, AnUnknownModeIsRefusedBeforeAnyRun) {
+  expectRefused("switching_experiment", "--runs 1 --out " + testing::TempDir() + "cli_modes --modes detailed,bogus",
+                "switching_experiment: --modes: unknown mode 'bogus' (modes: switching, fast, simple, basic, medium, detailed)");
+  expectRefused("switching_experiment", "--runs 1 --out " + testing::TempDir() + "cli_modes --modes ,",
+                "switching_experiment: --modes: unknown mode '' (modes:");
+}
+
 // The solver and friction study knobs (src/validation/README.md "Solver") are read from the environment by both
 // tools; a value they cannot use stops them before any trial (an unparsable iteration count used to
 // become 0 iterations through atoi).
