@@ -7,7 +7,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <deque>
 #include <fstream>
 #include <map>
@@ -651,10 +653,19 @@ std::vector<Outcome> runParallel(int n, int processes, const std::function<Outco
   for (int k = 0; k < processes; ++k) {
     char tmpl[] = "/tmp/sbot_validate_XXXXXX";
     const int fd = mkstemp(tmpl);
-    if (fd < 0) continue;
+    if (fd < 0) {  // its trials stay "error" in the report; say why
+      std::fprintf(stderr, "sbot_validate: worker %d of %d not started: cannot create a result file in /tmp: %s\n", k + 1,
+                   processes, std::strerror(errno));
+      continue;
+    }
     close(fd);
-    files.push_back(tmpl);
     const pid_t pid = fork();
+    if (pid < 0) {
+      std::fprintf(stderr, "sbot_validate: worker %d of %d not started: fork: %s\n", k + 1, processes, std::strerror(errno));
+      std::remove(tmpl);
+      continue;
+    }
+    files.push_back(tmpl);
     if (pid == 0) {
       std::ofstream f(files.back());
       for (int i = k; i < n; i += processes) {
@@ -677,6 +688,11 @@ std::vector<Outcome> runParallel(int n, int processes, const std::function<Outco
   for (pid_t p : pids) {
     int status = 0;
     waitpid(p, &status, 0);
+    // A worker that crashed (a signal, not an exception, which it reports itself) leaves its
+    // remaining trials "error" in the report; say so here, where the cause can still be seen.
+    if (WIFSIGNALED(status))
+      std::fprintf(stderr, "sbot_validate: a worker process died of signal %d (%s); its unfinished trials are marked error\n",
+                   WTERMSIG(status), strsignal(WTERMSIG(status)));
   }
   for (const auto& name : files) {
     std::ifstream f(name);
