@@ -1,5 +1,6 @@
 #include "sbot_sim/core/scenario.h"
 
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <random>
@@ -366,6 +367,91 @@ Scenario loadScenario(const std::string& path, int robot_count) {
   std::stringstream ss;
   ss << in.rdbuf();
   return parseScenario(ss.str(), path, robot_count);
+}
+
+std::string scenarioYaml(const Scenario& sc, const std::string& name, const std::string& description) {
+  const WorldConfig& w = sc.world;
+  const TerrainConfig& t = w.terrain;
+  YAML::Emitter e;
+  // Each double in its shortest form that reads back to the same value: the written world is the
+  // trial's own, bit for bit, and still reads "0.05" rather than "0.050000000000000003".
+  auto num = [](double v) {
+    char text[32];
+    const auto end = std::to_chars(text, text + sizeof text, v).ptr;
+    return std::string(text, end);
+  };
+  auto vec3 = [&](const Vec3& v) { e << YAML::Flow << YAML::BeginSeq << num(v.x()) << num(v.y()) << num(v.z()) << YAML::EndSeq; };
+  e << YAML::BeginMap;
+  e << YAML::Key << "name" << YAML::Value << name;
+  if (!description.empty()) e << YAML::Key << "description" << YAML::Value << description;
+  e << YAML::Key << "seed" << YAML::Value << w.seed;
+  e << YAML::Key << "duration" << YAML::Value << num(sc.duration);
+  if (!sc.effects_file.empty()) e << YAML::Key << "effects" << YAML::Value << sc.effects_file;
+  e << YAML::Key << "world" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "step" << YAML::Value << num(w.step);
+  e << YAML::Key << "gravity" << YAML::Value << num(w.gravity);
+  e << YAML::Key << "solver" << YAML::Value << w.solver;
+  e << YAML::Key << "solver_iterations" << YAML::Value << w.solver_iterations;
+  e << YAML::Key << "solver_sor" << YAML::Value << num(w.solver_sor);
+  e << YAML::Key << "lock_idle_turret" << YAML::Value << w.lock_idle_turret;
+  e << YAML::Key << "contact" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "mu" << YAML::Value << num(w.contact.mu);
+  e << YAML::Key << "erp" << YAML::Value << num(w.contact.erp);
+  e << YAML::Key << "cfm" << YAML::Value << num(w.contact.cfm);
+  e << YAML::Key << "bounce" << YAML::Value << num(w.contact.bounce);
+  e << YAML::Key << "max_contacts" << YAML::Value << w.contact.max_contacts;
+  e << YAML::Key << "coulomb" << YAML::Value << w.contact.coulomb;
+  e << YAML::Key << "materials" << YAML::Value << YAML::BeginMap;
+  for (const auto& [material, mu] : w.contact.material_mu) e << YAML::Key << material << YAML::Value << num(mu);
+  e << YAML::EndMap << YAML::EndMap;
+  e << YAML::Key << "terrain" << YAML::Value << YAML::BeginMap;
+  const char* type = t.type == TerrainConfig::Type::Plane ? "plane" : t.type == TerrainConfig::Type::Composite ? "composite" : "rough";
+  e << YAML::Key << "type" << YAML::Value << type;
+  e << YAML::Key << "ground_plane" << YAML::Value << t.ground_plane;
+  if (t.type == TerrainConfig::Type::Rough) {
+    if (t.size_x != t.size_y)
+      throw ConfigError(name, "world.terrain.size", "a scenario's rough terrain is square; this one is " +
+                                                        std::to_string(t.size_x) + " x " + std::to_string(t.size_y) + " m");
+    if (!t.heightmap_image.empty()) e << YAML::Key << "heightmap_image" << YAML::Value << t.heightmap_image;
+    e << YAML::Key << "resolution" << YAML::Value << t.resolution;
+    e << YAML::Key << "size" << YAML::Value << num(t.size_x);
+    e << YAML::Key << "height_range" << YAML::Value << num(t.height_range);
+    e << YAML::Key << "seed" << YAML::Value << t.heightmap_seed;
+  }
+  if (!t.boxes.empty()) {
+    e << YAML::Key << "boxes" << YAML::Value << YAML::BeginSeq;
+    for (const BoxObstacle& b : t.boxes) {
+      e << YAML::Flow << YAML::BeginMap;
+      e << YAML::Key << "name" << YAML::Value << b.name;
+      e << YAML::Key << "center" << YAML::Value;
+      vec3(b.center);
+      e << YAML::Key << "size" << YAML::Value;
+      vec3(b.size);
+      e << YAML::Key << "yaw" << YAML::Value << num(b.yaw) << YAML::Key << "pitch" << YAML::Value << num(b.pitch);
+      e << YAML::Key << "surface" << YAML::Value << b.surface;
+      e << YAML::EndMap;
+    }
+    e << YAML::EndSeq;
+  }
+  e << YAML::EndMap << YAML::EndMap;  // terrain, world
+  e << YAML::Key << "robots" << YAML::Value << YAML::BeginSeq;
+  for (const RobotSpawn& r : sc.robots) {
+    e << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << r.name << YAML::Key << "level"
+      << YAML::Value << r.level << YAML::Key << "pose" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "x"
+      << YAML::Value << num(r.pose.x) << YAML::Key << "y" << YAML::Value << num(r.pose.y) << YAML::Key << "yaw"
+      << YAML::Value << num(r.pose.yaw) << YAML::EndMap << YAML::EndMap;
+  }
+  e << YAML::EndSeq;
+  if (!sc.links.empty()) {
+    e << YAML::Key << "links" << YAML::Value << YAML::BeginSeq;
+    for (const LinkSpawn& l : sc.links)
+      e << YAML::Flow << YAML::BeginMap << YAML::Key << "holder" << YAML::Value << l.holder << YAML::Key << "held"
+        << YAML::Value << l.held << YAML::Key << "kind" << YAML::Value << (l.kind == 2 ? "side_arm" : "front_gripper")
+        << YAML::EndMap;
+    e << YAML::EndSeq;
+  }
+  e << YAML::EndMap;
+  return std::string(e.c_str()) + "\n";
 }
 
 }  // namespace sbot

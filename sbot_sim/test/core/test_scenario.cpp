@@ -150,6 +150,87 @@ TEST(Scenario, EffectsFileIsRelativeToTheScenario) {
   EXPECT_EQ(parseScenario("seed: 1", "/data/s.yaml").effects_file, "");
 }
 
+// scenarioYaml writes what parseScenario reads back (sbot_validate --scenario writes a validation
+// trial's world with it, to be watched in the node).
+TEST(Scenario, AWrittenScenarioReadsBackTheSame) {
+  const Scenario a = parseScenario(R"(
+seed: 11
+duration: 42
+effects: /abs/fitted.yaml
+world:
+  step: 0.005
+  gravity: 9.7
+  solver: exact
+  solver_iterations: 33
+  solver_sor: 1.2
+  lock_idle_turret: true
+  contact: {mu: 0.3, erp: 0.4, cfm: 2.0e-5, bounce: 0.1, max_contacts: 6, coulomb: false, materials: {track: 1.7, caster: 0.0}}
+  terrain:
+    type: composite
+    ground_plane: false
+    boxes:
+      - {name: ramp, center: [0.1234567891, -0.2, 0.05], size: [0.6, 1.0, 0.05], yaw: 0.3, pitch: -0.7, surface: white_paper}
+      - {name: step, center: [0.5, 0, 0.01], size: [1, 1, 0.02]}
+robots:
+  - {name: holder, level: medium, pose: {x: -0.12, y: 0.003, yaw: 3.1}}
+  - {name: held, level: medium, pose: {x: 0.2, y: 0, yaw: 0}}
+links: [{holder: holder, held: held, kind: side_arm}]
+)", "/abs/a.yaml");
+  const Scenario b = parseScenario(scenarioYaml(a, "round_trip", "written and read back"), "/abs/b.yaml");
+  EXPECT_EQ(b.world.seed, 11u);
+  EXPECT_DOUBLE_EQ(b.duration, 42);
+  EXPECT_EQ(b.effects_file, "/abs/fitted.yaml");
+  EXPECT_DOUBLE_EQ(b.world.step, 0.005);
+  EXPECT_DOUBLE_EQ(b.world.gravity, 9.7);
+  EXPECT_EQ(b.world.solver, "exact");
+  EXPECT_EQ(b.world.solver_iterations, 33);
+  EXPECT_DOUBLE_EQ(b.world.solver_sor, 1.2);
+  EXPECT_TRUE(b.world.lock_idle_turret);
+  EXPECT_DOUBLE_EQ(b.world.contact.mu, 0.3);
+  EXPECT_DOUBLE_EQ(b.world.contact.erp, 0.4);
+  EXPECT_DOUBLE_EQ(b.world.contact.cfm, 2.0e-5);
+  EXPECT_DOUBLE_EQ(b.world.contact.bounce, 0.1);
+  EXPECT_EQ(b.world.contact.max_contacts, 6);
+  EXPECT_FALSE(b.world.contact.coulomb);
+  EXPECT_EQ(b.world.contact.material_mu, a.world.contact.material_mu);
+  EXPECT_EQ(b.world.terrain.type, TerrainConfig::Type::Composite);
+  EXPECT_FALSE(b.world.terrain.ground_plane);
+  ASSERT_EQ(b.world.terrain.boxes.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const BoxObstacle &x = a.world.terrain.boxes[i], &y = b.world.terrain.boxes[i];
+    EXPECT_EQ(y.name, x.name);
+    EXPECT_TRUE(y.center.isApprox(x.center, 1e-12)) << y.center.transpose();
+    EXPECT_TRUE(y.size.isApprox(x.size, 1e-12));
+    EXPECT_DOUBLE_EQ(y.yaw, x.yaw);
+    EXPECT_DOUBLE_EQ(y.pitch, x.pitch);
+    EXPECT_EQ(y.surface, x.surface);
+  }
+  ASSERT_EQ(b.robots.size(), 2u);
+  EXPECT_EQ(b.robots[0].name, "holder");
+  EXPECT_EQ(b.robots[0].level, "medium");
+  EXPECT_DOUBLE_EQ(b.robots[0].pose.x, -0.12);
+  EXPECT_DOUBLE_EQ(b.robots[0].pose.y, 0.003);
+  EXPECT_DOUBLE_EQ(b.robots[0].pose.yaw, 3.1);
+  ASSERT_EQ(b.links.size(), 1u);
+  EXPECT_EQ(b.links[0].holder, "holder");
+  EXPECT_EQ(b.links[0].kind, 2);
+}
+
+TEST(Scenario, RoughTerrainIsWrittenSquareOrRefused) {
+  Scenario a;
+  a.world.terrain.type = TerrainConfig::Type::Rough;
+  a.world.terrain.size_x = a.world.terrain.size_y = 2.5;
+  a.world.terrain.height_range = 0.08;
+  a.world.terrain.heightmap_seed = 9;
+  const Scenario b = parseScenario(scenarioYaml(a, "rough"), "/abs/r.yaml");
+  EXPECT_EQ(b.world.terrain.type, TerrainConfig::Type::Rough);
+  EXPECT_DOUBLE_EQ(b.world.terrain.size_y, 2.5);
+  EXPECT_DOUBLE_EQ(b.world.terrain.height_range, 0.08);
+  EXPECT_EQ(b.world.terrain.heightmap_seed, 9u);
+  a.world.terrain.size_y = 3.0;
+  EXPECT_THROW(scenarioYaml(a, "rough"), ConfigError);
+}
+
 TEST(Scenario, MissingFileIsReported) {
   try {
     loadScenario("/nonexistent/scenario.yaml");

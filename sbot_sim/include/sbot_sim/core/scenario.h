@@ -62,6 +62,12 @@ struct Scenario {
 Scenario loadScenario(const std::string& path, int robot_count = -1);
 Scenario parseScenario(const std::string& yaml_text, const std::string& source, int robot_count = -1);
 
+/// `scenario` as a scenario file that parseScenario reads back to the same world, robots, links,
+/// seed and duration (`name` and `description` head it; the node's lamps are not part of a
+/// Scenario). Rough terrain is written with its image path as it is, so give an absolute one.
+/// Throws ConfigError for what the format cannot hold: a rough terrain that is not square.
+std::string scenarioYaml(const Scenario& scenario, const std::string& name, const std::string& description = "");
+
 /// The robots' levels against the world's gravity (the parsers call it; call it again after
 /// changing levels): a Fast robot only in its 1/50 g and never beside full-size robots. Throws
 /// ConfigError naming `source`, the robot and both gravities.
