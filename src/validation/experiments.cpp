@@ -200,28 +200,55 @@ bool studyKnobsOk(const char* tool) {
 
 // ---- Table 4.2 / 4.5: gap ------------------------------------------------------------------------
 
-Outcome gapTrial(const std::string& level, double gap_m, int trial, const Drive& drive) {
+TrialWorld gapWorld(const std::string& level, double gap_m, int trial, const Drive& drive) {
   const RobotDescription& d = loadLevel(level);
   const double s = lengthScale(level);
   Jitter j("gap" + level, gap_m, trial);
-  WorldConfig c = configFor(d, 1000 + trial);
+  TrialWorld t{configFor(d, 1000 + trial)};
   const double top = 0.10;
   // The half-size Fast robot crosses the gap halved, as its terrain is halved in 4.2.2 "to retain
   // comparable conditions" (the seed's Fast passing 6 cm, longer than itself, needs it too).
   const double gap = gap_m * s;
-  c.terrain.type = TerrainConfig::Type::Composite;
-  c.terrain.boxes.push_back(block(-1.0 - gap / 2, -gap / 2, top, "near_side"));
-  c.terrain.boxes.push_back(block(gap / 2, 1.0 + gap / 2, top, "far_side"));
-  World w(c);
+  t.world.terrain.type = TerrainConfig::Type::Composite;
+  t.world.terrain.boxes.push_back(block(-1.0 - gap / 2, -gap / 2, top, "near_side"));
+  t.world.terrain.boxes.push_back(block(gap / 2, 1.0 + gap / 2, top, "far_side"));
   const double x0 = -gap / 2 - 0.075 * s + j.uniform(-0.005, 0.005) * s;
-  Robot& r = spawn(w, d, {x0, j.uniform(-0.01, 0.01) * s, j.uniform(-0.05, 0.05)});
-  r.setSpeed(0, 0);
-  w.stepN(static_cast<int>(0.3 / c.step));
-  const double z0 = r.basePose().position.z();
-  r.setSpeed(drive.units, drive.units);
+  t.start = {x0, j.uniform(-0.01, 0.01) * s, j.uniform(-0.05, 0.05)};
+  t.units = drive.units;
+  t.seconds = (gap + 0.30 * s) / drive.speed(d) + 4.0;
+  return t;
+}
+
+namespace {
+
+/// A trial's world built and its robot spawned and standing for t.settle, the drive then set.
+struct StartedTrial {
+  World world;
+  Robot& robot;
+  double z0;  ///< [m] the base's height after standing
+  StartedTrial(const TrialWorld& t, const RobotDescription& d)
+      : world(t.world), robot(spawn(world, d, t.start)) {
+    robot.setSpeed(0, 0);
+    world.stepN(static_cast<int>(t.settle / t.world.step));
+    z0 = robot.basePose().position.z();
+    robot.setSpeed(t.units, t.units);
+  }
+};
+
+}  // namespace
+
+Outcome gapTrial(const std::string& level, double gap_m, int trial, const Drive& drive) {
+  const RobotDescription& d = loadLevel(level);
+  const double s = lengthScale(level);
+  const double gap = gap_m * s;
+  const TrialWorld t = gapWorld(level, gap_m, trial, drive);
+  StartedTrial st(t, d);
+  World& w = st.world;
+  Robot& r = st.robot;
+  const double z0 = st.z0;
   Outcome o{"stuck"};
   const double goal = gap / 2 + 0.09 * s;
-  runFor(w, (gap + 0.30 * s) / drive.speed(d) + 4.0, [&] {
+  runFor(w, t.seconds, [&] {
     const Vec3 p = r.basePose().position;
     const double tilt = angleBetween(upOf(r), Vec3::UnitZ());
     // Not kToppledTilt: a robot wedged nose-first in the gap at 50-70 deg has fallen inside (the
@@ -239,24 +266,31 @@ Outcome gapTrial(const std::string& level, double gap_m, int trial, const Drive&
 
 // ---- Table 4.3: step ------------------------------------------------------------------------------
 
-Outcome stepTrial(const std::string& level, double height_m, bool backward, int trial, const Drive& drive) {
+TrialWorld stepWorld(const std::string& level, double height_m, bool backward, int trial, const Drive& drive) {
   const RobotDescription& d = loadLevel(level);
   const double s = lengthScale(level);
   Jitter j(std::string("step") + (backward ? "b" : "f") + level, height_m, trial);
-  WorldConfig c = configFor(d, 2000 + trial);
-  c.terrain.type = TerrainConfig::Type::Composite;
-  c.terrain.boxes.push_back(block(0.0, 1.0, height_m, "step"));
-  World w(c);
+  TrialWorld t{configFor(d, 2000 + trial)};
+  t.world.terrain.type = TerrainConfig::Type::Composite;
+  t.world.terrain.boxes.push_back(block(0.0, 1.0, height_m, "step"));
   const double x0 = -0.075 * s + j.uniform(-0.005, 0.005) * s;
   const double yaw = (backward ? M_PI : 0.0) + j.uniform(-0.03, 0.03);
-  Robot& r = spawn(w, d, {x0, j.uniform(-0.01, 0.01) * s, yaw});
-  r.setSpeed(0, 0);
-  w.stepN(static_cast<int>(0.3 / c.step));
-  const double z0 = r.basePose().position.z();
-  const int u = backward ? -drive.units : drive.units;
-  r.setSpeed(u, u);
+  t.start = {x0, j.uniform(-0.01, 0.01) * s, yaw};
+  t.units = backward ? -drive.units : drive.units;
+  t.seconds = 0.25 * s / drive.speed(d) + 8.0;
+  return t;
+}
+
+Outcome stepTrial(const std::string& level, double height_m, bool backward, int trial, const Drive& drive) {
+  const RobotDescription& d = loadLevel(level);
+  const double s = lengthScale(level);
+  const TrialWorld t = stepWorld(level, height_m, backward, trial, drive);
+  StartedTrial st(t, d);
+  World& w = st.world;
+  Robot& r = st.robot;
+  const double z0 = st.z0;
   Outcome o{"fail"};
-  runFor(w, 0.25 * s / drive.speed(d) + 8.0, [&] {
+  runFor(w, t.seconds, [&] {
     const Vec3 p = r.basePose().position;
     const double tilt = angleBetween(upOf(r), Vec3::UnitZ());
     // A robot that reverses up a step nose-first onto its held gripper stands at 70-77 deg and can
@@ -320,21 +354,29 @@ Outcome slopeHoldClimbTrial(const std::string& level, double angle_rad, bool bac
 
 // ---- Table 4.6: uphill ramp from flat ground -----------------------------------------------------
 
-Outcome uphillTrial(const std::string& level, double angle_rad, int trial, const Drive& drive) {
+TrialWorld uphillWorld(const std::string& level, double angle_rad, int trial, const Drive& drive) {
   const RobotDescription& d = loadLevel(level);
   const double s = lengthScale(level);
   Jitter j("uphill" + level, angle_rad, trial);
-  WorldConfig c = configFor(d, 4000 + trial);
-  c.terrain.type = TerrainConfig::Type::Composite;
-  c.terrain.boxes.push_back(ramp(Vec3(0, 0, 0), angle_rad, 0.6 * s, "ramp"));
-  World w(c);
+  TrialWorld t{configFor(d, 4000 + trial)};
+  t.world.terrain.type = TerrainConfig::Type::Composite;
+  t.world.terrain.boxes.push_back(ramp(Vec3(0, 0, 0), angle_rad, 0.6 * s, "ramp"));
   const double yaw0 = j.uniform(-0.05, 0.05);
-  Robot& r = spawn(w, d, {-0.12 * s + j.uniform(-0.01, 0.01) * s, j.uniform(-0.01, 0.01) * s, yaw0});
-  r.setSpeed(0, 0);
-  w.stepN(static_cast<int>(0.3 / c.step));
+  t.start = {-0.12 * s + j.uniform(-0.01, 0.01) * s, j.uniform(-0.01, 0.01) * s, yaw0};
+  t.units = drive.units;
+  t.seconds = (0.12 * s + 0.30 * s) / drive.speed(d) * 1.3 + 4.0;
+  return t;
+}
+
+Outcome uphillTrial(const std::string& level, double angle_rad, int trial, const Drive& drive) {
+  const RobotDescription& d = loadLevel(level);
+  const double s = lengthScale(level);
+  const TrialWorld t = uphillWorld(level, angle_rad, trial, drive);
+  StartedTrial st(t, d);
+  World& w = st.world;
+  Robot& r = st.robot;
   const double h0 = headingOf(r);
-  const double z0 = r.basePose().position.z();
-  r.setSpeed(drive.units, drive.units);
+  const double z0 = st.z0;
   const Vec3 normal(-std::sin(angle_rad), 0, std::cos(angle_rad));
   double best = 0;
   Outcome o{"stuck"};
@@ -346,9 +388,9 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial, const
   // speed relative to the command), do the driven wheels carry weight, has the robot moved?
   std::deque<double> track_ratio, load_ratio;
   std::deque<Vec3> positions;
-  const double weight = d.totalMass() * c.gravity;
-  const std::size_t window = static_cast<std::size_t>(std::lround(2.0 / (checkEvery(w) * c.step)));  // 2 s
-  runFor(w, (0.12 * s + 0.30 * s) / drive.speed(d) * 1.3 + 4.0, [&] {
+  const double weight = d.totalMass() * t.world.gravity;
+  const std::size_t window = static_cast<std::size_t>(std::lround(2.0 / (checkEvery(w) * t.world.step)));  // 2 s
+  runFor(w, t.seconds, [&] {
     track_ratio.push_back(0.5 * (std::fabs(r.trackSpeedLeft()) + std::fabs(r.trackSpeedRight())) / drive.speed(d));
     load_ratio.push_back(r.driveWheelLoad() / weight);
     positions.push_back(r.basePose().position);
@@ -388,26 +430,40 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial, const
   return o;
 }
 
-Outcome downhillTrial(const std::string& level, double angle_rad, int trial, const Drive& drive) {
+namespace {
+/// 4.2.4's ramp: this long along its slope [m], for a robot of length scale `s`.
+double downhillRampLength(double s) { return 0.4 * s; }
+}  // namespace
+
+TrialWorld downhillWorld(const std::string& level, double angle_rad, int trial, const Drive& drive) {
   const RobotDescription& d = loadLevel(level);
   const double s = lengthScale(level);
   Jitter j("downhill" + level, angle_rad, trial);
-  WorldConfig c = configFor(d, 5000 + trial);
-  c.terrain.type = TerrainConfig::Type::Composite;
-  const double L = 0.4 * s;
+  TrialWorld t{configFor(d, 5000 + trial)};
+  t.world.terrain.type = TerrainConfig::Type::Composite;
+  const double L = downhillRampLength(s);
   const double H = L * std::sin(angle_rad);
-  c.terrain.boxes.push_back(block(-1.0, 0.0, H, "plateau"));
-  c.terrain.boxes.push_back(ramp(Vec3(0, 0, H), -angle_rad, L + 0.05, "ramp"));
-  World w(c);
-  Robot& r = spawn(w, d, {-0.10 * s + j.uniform(-0.01, 0.01) * s, j.uniform(-0.01, 0.01) * s, j.uniform(-0.05, 0.05)});
-  r.setSpeed(0, 0);
-  w.stepN(static_cast<int>(0.3 / c.step));
+  t.world.terrain.boxes.push_back(block(-1.0, 0.0, H, "plateau"));
+  t.world.terrain.boxes.push_back(ramp(Vec3(0, 0, H), -angle_rad, L + 0.05, "ramp"));
+  t.start = {-0.10 * s + j.uniform(-0.01, 0.01) * s, j.uniform(-0.01, 0.01) * s, j.uniform(-0.05, 0.05)};
+  t.units = drive.units;
+  t.seconds = (0.10 * s + L + 0.1 * s) / drive.speed(d) * 1.3 + 4.0;
+  return t;
+}
+
+Outcome downhillTrial(const std::string& level, double angle_rad, int trial, const Drive& drive) {
+  const RobotDescription& d = loadLevel(level);
+  const double s = lengthScale(level);
+  const double L = downhillRampLength(s);
+  const TrialWorld t = downhillWorld(level, angle_rad, trial, drive);
+  StartedTrial st(t, d);
+  World& w = st.world;
+  Robot& r = st.robot;
   const double h0 = headingOf(r);
-  r.setSpeed(drive.units, drive.units);
   Outcome o{"stuck"};
   const double foot = L * std::cos(angle_rad), goal = foot + 0.10 * s;
   const Vec3 ramp_normal(std::sin(angle_rad), 0, std::cos(angle_rad));  // the ramp falls toward +x
-  runFor(w, (0.10 * s + L + 0.1 * s) / drive.speed(d) * 1.3 + 4.0, [&] {
+  runFor(w, t.seconds, [&] {
     // Toppled forward: over, or tilted more than 45 deg off the normal of the surface under its
     // base (plateau, ramp, floor), i.e. pitched onto its nose or gripper (Table 4.3's rule). Until
     // 2026-11-26 only "over" (100 deg) counted, and a Detailed robot that pitched 84 deg onto its
@@ -597,23 +653,28 @@ const std::vector<ExperimentKind>& experimentKinds() {
   static const std::vector<ExperimentKind> kinds = {
       {"gap", "gap width, m", 0.0, 0.3, {"pass", "fall inside", "stuck", "topple"}, {"base x at the end (gap centre at 0)", "m"},
        {"base drop", "m"},
-       [](const std::string& l, double p, int i, const Drive& d) { return gapTrial(l, p, i, d); }},
+       [](const std::string& l, double p, int i, const Drive& d) { return gapTrial(l, p, i, d); },
+       [](const std::string& l, double p, int i, const Drive& d) { return gapWorld(l, p, i, d); }},
       {"step", "step height, m", 0.0, 0.1, {"pass", "fail", "topple"}, {"base x at the end (step edge at 0)", "m"},
        {"base rise", "m"},
-       [](const std::string& l, double p, int i, const Drive& d) { return stepTrial(l, p, false, i, d); }},
+       [](const std::string& l, double p, int i, const Drive& d) { return stepTrial(l, p, false, i, d); },
+       [](const std::string& l, double p, int i, const Drive& d) { return stepWorld(l, p, false, i, d); }},
       {"stepb", "step height, m", 0.0, 0.1, {"pass", "fail", "topple"}, {"base x at the end (step edge at 0)", "m"},
        {"base rise", "m"},
-       [](const std::string& l, double p, int i, const Drive& d) { return stepTrial(l, p, true, i, d); }},
+       [](const std::string& l, double p, int i, const Drive& d) { return stepTrial(l, p, true, i, d); },
+       [](const std::string& l, double p, int i, const Drive& d) { return stepWorld(l, p, true, i, d); }},
       {"slope", "slope, deg", 0.0, 89.0, {"full", "difficult", "slide", "topple b/w"}, {"climb efficiency", ""}, {"max tilt", "rad"},
        [](const std::string& l, double p, int i, const Drive& d) { return slopeHoldClimbTrial(l, p * M_PI / 180, false, i, d); }},
       {"slopeb", "slope, deg", 0.0, 89.0, {"full", "difficult", "slide", "topple b/w"}, {"climb efficiency", ""}, {"max tilt", "rad"},
        [](const std::string& l, double p, int i, const Drive& d) { return slopeHoldClimbTrial(l, p * M_PI / 180, true, i, d); }},
       {"uphill", "ramp angle, rad", 0.0, 1.5, {"climb", "c/c", "stuck", "slipping", "slide back", "topple"},
        {"furthest up the ramp", "m"}, {"heading change", "rad"},
-       [](const std::string& l, double p, int i, const Drive& d) { return uphillTrial(l, p, i, d); }},
+       [](const std::string& l, double p, int i, const Drive& d) { return uphillTrial(l, p, i, d); },
+       [](const std::string& l, double p, int i, const Drive& d) { return uphillWorld(l, p, i, d); }},
       {"downhill", "ramp angle, rad", 0.0, 1.5, {"pass", "topple", "c/c", "stuck"}, {"base x at the end (plateau edge at 0)", "m"},
        {"heading change", "rad"},
-       [](const std::string& l, double p, int i, const Drive& d) { return downhillTrial(l, p, i, d); }},
+       [](const std::string& l, double p, int i, const Drive& d) { return downhillTrial(l, p, i, d); },
+       [](const std::string& l, double p, int i, const Drive& d) { return downhillWorld(l, p, i, d); }},
       {"rough", "height range HR, cm", 0.0, 100.0, {}, {"distance along the start heading", "m"}, {"heading change", "rad"},
        [](const std::string& l, double p, int i, const Drive&) { return roughTrial(l, p, i, g_rough_heightmap); }},
       {"rtm", "simulated time, s", 0.1, 3600.0, {}, {"real-time multiplier", ""}, {"wall time per step", "ms"}, [](const std::string& l, double p, int, const Drive&) { return rtmTrial(l, p); }},

@@ -13,11 +13,12 @@
 #include <string>
 #include <vector>
 
+#include "sbot_sim/core/types.h"
+#include "sbot_sim/core/world_config.h"
 #include "step_statics.h"
 
 namespace sbot {
 struct RobotDescription;
-struct WorldConfig;
 namespace validation {
 
 struct Outcome {
@@ -58,15 +59,28 @@ struct Drive {
   double speed(const RobotDescription& d) const;
 };
 
+/// The world and start of one labelled trial before it runs: the trials below build theirs with it,
+/// and `sbot_validate --scenario` writes it as a scenario file, so that a cell can be watched in the
+/// simulator node and rviz (trialScenario).
+struct TrialWorld {
+  WorldConfig world;   ///< terrain, step, gravity, seed and the study knobs
+  Pose2D start;        ///< the robot's spawn pose (its start perturbation included)
+  double settle = 0.3; ///< [s] standing with setSpeed(0, 0) first
+  int units = 0;       ///< then setSpeed(units, units) (negative: reversing)
+  double seconds = 0;  ///< [s] the trial's time limit after that
+};
+
 /// Table 4.2 / 4.5: drive at 2.8 cm/s across a gap `gap_m` wide between two 10 cm high platforms
 /// (Fast: half as wide, like its half-size terrain in 4.2.2).
 /// Labels: pass, fall inside (its base dropped > 2 cm, Fast 1 cm), stuck (at the edge), topple.
 /// value = base x [m], value2 = how far the base dropped [m].
 Outcome gapTrial(const std::string& level, double gap_m, int trial, const Drive& drive = Drive());
+TrialWorld gapWorld(const std::string& level, double gap_m, int trial, const Drive& drive = Drive());
 
 /// Table 4.3: drive into a step `height_m` high, forward (backward = false) or backward.
 /// Labels: pass, fail, topple.
 Outcome stepTrial(const std::string& level, double height_m, bool backward, int trial, const Drive& drive = Drive());
+TrialWorld stepWorld(const std::string& level, double height_m, bool backward, int trial, const Drive& drive = Drive());
 
 /// Table 4.1's slope is "a rigid polystyrene plastic" (4.1.1), a surface of its own: the treels'
 /// Coulomb coefficient on it. The seed gives none; the hardware pair stood upright on 58 deg, which
@@ -86,9 +100,11 @@ Outcome slopeHoldClimbTrial(const std::string& level, double angle_rad, bool bac
 /// Table 4.6: drive from flat ground at 2.8 cm/s into an uphill ramp of `angle_rad`.
 /// Labels: climb, c/c, stuck, slipping, slide back, topple.
 Outcome uphillTrial(const std::string& level, double angle_rad, int trial, const Drive& drive = Drive());
+TrialWorld uphillWorld(const std::string& level, double angle_rad, int trial, const Drive& drive = Drive());
 
 /// 4.2.4 downhill: drive from a plateau down a ramp of `angle_rad`. Labels: pass, topple, stuck.
 Outcome downhillTrial(const std::string& level, double angle_rad, int trial, const Drive& drive = Drive());
+TrialWorld downhillWorld(const std::string& level, double angle_rad, int trial, const Drive& drive = Drive());
 
 /// Figure 4.4: random pose and heading on rough terrain of height range `hr_cm` [cm], 10 s at
 /// 15.24 cm/s; value = travelled distance projected on the initial heading [m].
@@ -157,6 +173,9 @@ struct ExperimentKind {
   Measure value, value2;            ///< what Outcome::value and value2 measure
   /// The trial; `drive` applies to the labelled kinds (the measurements have their own speeds).
   std::function<Outcome(const std::string& level, double param, int trial, const Drive& drive)> run;
+  /// Its world before it runs, for the kinds a scenario file can hold (gap, step, stepb, uphill,
+  /// downhill); empty for the others (slope tilts gravity, a scenario's points down).
+  std::function<TrialWorld(const std::string& level, double param, int trial, const Drive& drive)> world;
 };
 /// gap, step, stepb (backward), slope, slopeb (rear uphill), uphill, downhill: labelled;
 /// rough, rtm, speed: measurements. `rough` runs on setRoughHeightmap's image.

@@ -23,6 +23,11 @@
 // KIND: gap, step, stepb, slope, slopeb, uphill, downhill, rough, rtm, speed (PARAM: m, m, m, deg,
 // deg, rad, rad, HR in cm, simulated s, setSpeed units of the compatibility check; ranges in
 // experimentKinds(), experiments.h).
+//
+//   sbot_validate --scenario FILE [--index N] [--speed UNITS] --trial KIND LEVEL PARAM
+//     the trial is not run: its world and start are written to FILE as a scenario for the simulator
+//     node, with the roslaunch and rostopic commands to watch it in rviz (gap, step, stepb, uphill,
+//     downhill; a slope trial tilts gravity, which a scenario cannot).
 #include <unistd.h>
 
 #include <algorithm>
@@ -50,6 +55,7 @@
 #include "two_sbots_trials.h"
 #include "sbot_sim/core/output_files.h"
 #include "sbot_sim/core/robot_description.h"
+#include "sbot_sim/core/scenario.h"
 #include "sbot_sim/core/terrain.h"
 #include "sbot_sim/core/world_config.h"
 
@@ -593,6 +599,48 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
   for (const std::string& p : t.after) md << builtInParagraph(p);
 }
 
+/// --scenario FILE --trial KIND LEVEL PARAM: the trial's world and start as a scenario file for the
+/// simulator node, so that a cell can be watched in rviz (how, printed). Exit status as main's.
+int writeTrialScenario(const std::string& file, const v::ExperimentKind& kind, const std::string& level, double param,
+                       int index, const v::Drive& drive) {
+  const std::string what = kind.name + " " + level + " " + fmt(param, 4);
+  if (!kind.world) {
+    std::string kinds;
+    for (const v::ExperimentKind& k : v::experimentKinds())
+      if (k.world) kinds += (kinds.empty() ? "" : ", ") + k.name;
+    std::fprintf(stderr,
+                 "sbot_validate: --scenario: a %s trial cannot be written as a scenario (a scenario's gravity points "
+                 "straight down and its terrain is planes, boxes or a height field); these kinds can: %s\n",
+                 kind.name.c_str(), kinds.c_str());
+    return 2;
+  }
+  const v::TrialWorld t = kind.world(level, param, index, drive);
+  sbot::Scenario sc;
+  sc.world = t.world;
+  sc.robots.push_back({"sbot_0", level, t.start});
+  sc.duration = 0;  // driven by hand: until stopped
+  const std::string drive_cmd = "rostopic pub -1 /sbot_0/cmd_speed sbot_msgs/TrackSpeed '{left: " +
+                                std::to_string(t.units) + ", right: " + std::to_string(t.units) + "}'";
+  const std::string header =
+      "# Validation trial '" + what + "', trial " + std::to_string(index) + " of its cell (start perturbation included),\n"
+      "# written by sbot_validate --scenario. To watch it:\n"
+      "#   roslaunch swarmbot3d swarm.launch scenario:=" + file + " robots:=1 level:=" + level +
+      " controller:=false headless:=false real_time_factor:=1\n"
+      "#   " + drive_cmd + "   # the trial's drive, after it stood " + fmt(t.settle, 1) + " s\n"
+      "# The trial's own time limit: " + fmt(t.seconds, 1) + " s of driving.\n";
+  try {
+    sbot::writeTextFile(file, header + sbot::scenarioYaml(sc, "trial_" + kind.name + "_" + level,
+                                                          "sbot_validate trial " + what + ", index " + std::to_string(index)));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sbot_validate: --scenario: %s\n", e.what());
+    return 2;
+  }
+  std::printf("wrote %s: trial %s (index %d)\nwatch it:\n  roslaunch swarmbot3d swarm.launch scenario:=%s robots:=1 "
+              "level:=%s controller:=false headless:=false real_time_factor:=1\n  %s\n",
+              file.c_str(), what.c_str(), index, file.c_str(), level.c_str(), drive_cmd.c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -601,6 +649,7 @@ int main(int argc, char** argv) {
   bool trace = false;
   int index = 0;  // --index: which trial of a cell --trial runs (its start perturbation)
   v::Drive drive;  // --speed: the labelled trials' setSpeed units (default: the seed's 2.8 cm/s)
+  std::string scenario_file;  // --scenario: write --trial's world as a scenario file instead of running it
   sbot_tools::ArgReader args("sbot_validate", argc, argv);
   while (args.more()) {
     const std::string a = args.option();
@@ -614,6 +663,7 @@ int main(int argc, char** argv) {
     else if (a == "--trace") trace = true;  // with --trial (before it): the robot's state every 0.1 s
     else if (a == "--index") index = args.count(0, 999);  // with --trial (before it): the cell's trial N
     else if (a == "--speed") drive.units = args.count(1, 70);  // with --trial (before it): setSpeed units
+    else if (a == "--scenario") scenario_file = args.value();  // with --trial (before it): write, do not run
     else if (a == "--trial") {  // --trial KIND LEVEL PARAM: one trial, printed (tuning aid)
       const std::string kind = args.value(), level = args.value();
       const v::ExperimentKind* k = v::findExperimentKind(kind);
@@ -624,6 +674,7 @@ int main(int argc, char** argv) {
       sbot_tools::requireLevel("sbot_validate", "--trial " + kind + " " + level, level);
       const double p = sbot_tools::numberArg(args.tool(), "--trial " + kind + " " + level + " (" + k->unit + ")",
                                              args.value(), k->min, k->max);
+      if (!scenario_file.empty()) return writeTrialScenario(scenario_file, *k, level, p, index, drive);
       v::setTrace(trace);
       v::setRoughHeightmap(findHeightmap());
       const Outcome r = k->run(level, p, index, drive);
@@ -639,7 +690,8 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr, "usage: sbot_validate --out DIR [--quick] [--trials N] [--jobs N] [--only LIST]\n"
                            "                     [--tables YAML] [--reasons YAML] [--heightmap PNG]\n"
-                           "       sbot_validate [--trace] [--index N] [--speed UNITS] --trial KIND LEVEL PARAM\n");
+                           "       sbot_validate [--trace] [--index N] [--speed UNITS] --trial KIND LEVEL PARAM\n"
+                           "       sbot_validate --scenario FILE [--index N] [--speed UNITS] --trial KIND LEVEL PARAM\n");
       return a == "--help" ? 0 : 2;
     }
   }

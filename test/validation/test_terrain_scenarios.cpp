@@ -1,5 +1,6 @@
 // The shipped terrain scenarios (config/scenarios/{rough_terrain,composite_course}.yaml) load, and a
-// robot spawned on the rough terrain's height field rests on it at the right height.
+// robot spawned on the rough terrain's height field rests on it at the right height. A validation
+// trial's world written as a scenario (sbot_validate --scenario) reads back as that very world.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +10,7 @@
 #include "sbot_sim/core/scenario.h"
 #include "sbot_sim/core/terrain.h"
 #include "sbot_sim/core/world.h"
+#include "experiments.h"
 
 namespace sbot {
 namespace {
@@ -62,6 +64,44 @@ TEST(TerrainScenarios, CompositeCourseLoads) {
   Robot& r = w.addRobot(loadLevel(s.robots.at(0).level), s.robots.at(0).pose, s.robots.at(0).name);
   w.stepN(100);
   EXPECT_NEAR(r.basePose().position.z(), 0.10 + 0.022, 0.006) << "on the start platform";
+}
+
+// Every kind that can be written: the parsed scenario holds the trial's terrain, step, gravity,
+// seed, contact model and start pose exactly (doubles in their shortest round-trip form), so a
+// robot spawned from it starts where the trial's does.
+TEST(TerrainScenarios, ATrialsWorldWrittenAsAScenarioReadsBackExactly) {
+  int written = 0;
+  for (const validation::ExperimentKind& k : validation::experimentKinds()) {
+    if (!k.world) continue;
+    ++written;
+    const double param = k.name == "uphill" || k.name == "downhill" ? 0.7 : 0.037;
+    for (const std::string level : {"fast", "detailed"}) {
+      const validation::TrialWorld t = k.world(level, param, 3, validation::Drive());
+      Scenario a;
+      a.world = t.world;
+      a.robots.push_back({"sbot_0", level, t.start});
+      const Scenario b = parseScenario(scenarioYaml(a, "trial"), "/abs/trial.yaml");
+      const std::string what = k.name + " " + level;
+      EXPECT_EQ(b.world.step, t.world.step) << what;
+      EXPECT_EQ(b.world.gravity, t.world.gravity) << what;
+      EXPECT_EQ(b.world.seed, t.world.seed) << what;
+      EXPECT_EQ(b.world.contact.material_mu, t.world.contact.material_mu) << what;
+      EXPECT_EQ(b.world.contact.mu, t.world.contact.mu) << what;
+      EXPECT_EQ(b.world.terrain.type, t.world.terrain.type) << what;
+      ASSERT_EQ(b.world.terrain.boxes.size(), t.world.terrain.boxes.size()) << what;
+      for (std::size_t i = 0; i < t.world.terrain.boxes.size(); ++i) {
+        EXPECT_EQ(b.world.terrain.boxes[i].center, t.world.terrain.boxes[i].center) << what << " box " << i;
+        EXPECT_EQ(b.world.terrain.boxes[i].size, t.world.terrain.boxes[i].size) << what << " box " << i;
+        EXPECT_EQ(b.world.terrain.boxes[i].pitch, t.world.terrain.boxes[i].pitch) << what << " box " << i;
+      }
+      ASSERT_EQ(b.robots.size(), 1u);
+      EXPECT_EQ(b.robots[0].level, level);
+      EXPECT_EQ(b.robots[0].pose.x, t.start.x) << what;
+      EXPECT_EQ(b.robots[0].pose.y, t.start.y) << what;
+      EXPECT_EQ(b.robots[0].pose.yaw, t.start.yaw) << what;
+    }
+  }
+  EXPECT_EQ(written, 5) << "gap, step, stepb, uphill and downhill";
 }
 
 }  // namespace

@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "../common/run_process.h"
@@ -236,6 +238,28 @@ TEST(ToolsCli, AnOutputPlaceThatCannotBeWrittenIsRefusedBeforeAnyRun) {
   std::string first;
   std::getline(report, first);
   EXPECT_EQ(first, "# swarmbot3d validation report");
+}
+
+// --scenario FILE --trial ...: the trial's world and start as a scenario file for the node (to watch
+// a cell in rviz), with the commands to do so; a kind a scenario cannot hold is refused by name.
+TEST(ToolsCli, ATrialIsWrittenAsAScenarioToWatch) {
+  const std::string file = testing::TempDir() + "cli_trial_scenario.yaml";
+  std::remove(file.c_str());
+  Outcome o = run("sbot_validate", "--scenario " + file + " --index 2 --speed 20 --trial stepb detailed 0.015");
+  EXPECT_EQ(o.status, 0) << o.output;
+  EXPECT_NE(o.output.find("roslaunch swarmbot3d swarm.launch scenario:=" + file + " robots:=1 level:=detailed"),
+            std::string::npos)
+      << o.output;
+  EXPECT_NE(o.output.find("/sbot_0/cmd_speed sbot_msgs/TrackSpeed '{left: -20, right: -20}'"), std::string::npos)
+      << "reversing at --speed: " << o.output;
+  std::ifstream in(file);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("- {name: step, center: [0.5, 0, 0.0075], size: [1, 1, 0.015]"), std::string::npos) << text;
+  EXPECT_NE(text.find("- {name: sbot_0, level: detailed, pose: {x: -0.07"), std::string::npos) << text;
+  expectRefused("sbot_validate", "--scenario " + file + " --trial slope detailed 20",
+                "--scenario: a slope trial cannot be written as a scenario");
+  expectRefused("sbot_validate", "--scenario /proc/sbot_no_such_place/t.yaml --trial gap detailed 0.03",
+                "--scenario: cannot write '/proc/sbot_no_such_place/t.yaml'");
 }
 
 TEST(ToolsCli, AValidTrialRuns) {
