@@ -619,13 +619,15 @@ int writeTrialScenario(const std::string& file, const v::ExperimentKind& kind, c
   sc.world = t.world;
   sc.robots.push_back({"sbot_0", level, t.start});
   sc.duration = 0;  // driven by hand: until stopped
+  // The two commands that show it, written into the file's header and printed.
+  const std::string launch_cmd = "roslaunch swarmbot3d swarm.launch scenario:=" + file + " robots:=1 level:=" + level +
+                                 " controller:=false headless:=false real_time_factor:=1";
   const std::string drive_cmd = "rostopic pub -1 /sbot_0/cmd_speed sbot_msgs/TrackSpeed '{left: " +
                                 std::to_string(t.units) + ", right: " + std::to_string(t.units) + "}'";
   const std::string header =
       "# Validation trial '" + what + "', trial " + std::to_string(index) + " of its cell (start perturbation included),\n"
       "# written by sbot_validate --scenario. To watch it:\n"
-      "#   roslaunch swarmbot3d swarm.launch scenario:=" + file + " robots:=1 level:=" + level +
-      " controller:=false headless:=false real_time_factor:=1\n"
+      "#   " + launch_cmd + "\n"
       "#   " + drive_cmd + "   # the trial's drive, after it stood " + fmt(t.settle, 1) + " s\n"
       "# The trial's own time limit: " + fmt(t.seconds, 1) + " s of driving.\n";
   try {
@@ -635,9 +637,8 @@ int writeTrialScenario(const std::string& file, const v::ExperimentKind& kind, c
     std::fprintf(stderr, "sbot_validate: --scenario: %s\n", e.what());
     return 2;
   }
-  std::printf("wrote %s: trial %s (index %d)\nwatch it:\n  roslaunch swarmbot3d swarm.launch scenario:=%s robots:=1 "
-              "level:=%s controller:=false headless:=false real_time_factor:=1\n  %s\n",
-              file.c_str(), what.c_str(), index, file.c_str(), level.c_str(), drive_cmd.c_str());
+  std::printf("wrote %s: trial %s (index %d)\nwatch it:\n  %s\n  %s\n", file.c_str(), what.c_str(), index,
+              launch_cmd.c_str(), drive_cmd.c_str());
   return 0;
 }
 
