@@ -219,13 +219,43 @@ TEST(DriveEffects, TorqueEffectsShowInTheTorqueReadings) {
 }
 
 TEST(DriveEffects, AnisotropicTrackFrictionChangesSkidSteering) {
-  const Outcome spin = drive({}, 40, -40, 2.0, "medium");
-  const Outcome slippery = drive({{"track_friction_anisotropy", {{"lateral_ratio", 0.3}}, {}, ""}}, 40, -40, 2.0, "medium");
-  EXPECT_GT(std::abs(slippery.turned), 1.05 * std::abs(spin.turned))
-      << "less lateral grip: the six-wheel model skids round more easily";
-  // lateral_ratio -> 1 is continuous with the effect off (the core's pyramid is heading-aligned too).
-  const Outcome almost = drive({{"track_friction_anisotropy", {{"lateral_ratio", 0.999}}, {}, ""}}, 40, -40, 2.0, "medium");
-  EXPECT_NEAR(almost.turned, spin.turned, 0.01 * std::abs(spin.turned));
+  // Mean over three seeds: quickstep on six wheels turns one 2 s spin by a few % more or less from
+  // seed to seed, and by as much for a lateral ratio of 0.9999 (2026-11-27: -4.08 to -4.50 rad).
+  auto turned = [](double ratio) {
+    std::vector<EffectConfig> effects;
+    if (ratio != 1.0) effects.push_back({"track_friction_anisotropy", {{"lateral_ratio", ratio}}, {}, ""});
+    double sum = 0;
+    for (std::uint64_t seed : {1, 2, 3}) sum += drive(effects, 40, -40, 2.0, "medium", seed).turned;
+    return sum / 3;
+  };
+  const double off = turned(1.0), slippery = turned(0.3), almost = turned(0.999);
+  EXPECT_GT(std::abs(slippery), 1.15 * std::abs(off)) << "less lateral grip: the six-wheel model skids round more easily";
+  // lateral_ratio -> 1 is continuous with the effect off (the next test: it keeps the core's pyramid).
+  EXPECT_LT(std::abs(almost - off), 0.2 * std::abs(slippery - off));
+}
+
+TEST(DriveEffects, AnisotropicTrackFrictionKeepsTheCoresFrictionDirection) {
+  // Along the track is the pyramid's first direction the core gives a terrain contact (the way the
+  // wheels roll: the heading on a floor, up a face ahead); across it, mu x lateral_ratio. A
+  // robot-robot contact has no direction from the core and takes the robot's heading.
+  World w(flatWorld());
+  const Robot& r = w.addRobot(loadLevel("medium"), {0, 0, 0}, "sbot_0");
+  TrackFrictionAnisotropyEffect effect({{"lateral_ratio", 0.5}});
+  ContactContext ctx;
+  ctx.robot_a = &r;
+  ctx.material_a = "track";
+  ctx.normal = Vec3(-1, 0, 0);  // a face ahead
+  ctx.heading = Vec3(0, 1, 0);  // the projected heading's sideways remnant
+  ctx.fdir1 = Vec3(0, 0, 1);    // the core's: up the face
+  dSurfaceParameters surface{};
+  surface.mu = 0.8;
+  effect.onContact(ctx, surface);
+  EXPECT_EQ(ctx.fdir1, Vec3(0, 0, 1));
+  EXPECT_TRUE(surface.mode & dContactMu2);
+  EXPECT_NEAR(surface.mu2, 0.4, 1e-12);
+  ctx.fdir1 = Vec3::Zero();
+  effect.onContact(ctx, surface);
+  EXPECT_EQ(ctx.fdir1, ctx.heading);
 }
 
 }  // namespace

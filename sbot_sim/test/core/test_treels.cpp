@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "sbot_sim/core/effects.h"
 #include "sbot_sim/core/errors.h"
 #include "sim_fixture.h"
 
@@ -685,6 +686,41 @@ TEST(TreelsFriction, ForceLimitLawHoldsEachContactToAFixedForce) {
   EXPECT_LT(slid(Law::Coulomb, 0.3), 0.01) << "the limit is ignored under Coulomb";
   EXPECT_LT(slid(Law::ForceLimit, 1.2), 0.01);
   EXPECT_GT(slid(Law::ForceLimit, 0.3), 0.05);
+}
+
+/// Records the first friction direction of every robot contact with the terrain: on faces (normal
+/// within 17 deg of horizontal) and on the floor (normal within 17 deg of vertical).
+class FrictionDirections : public Effect {
+ public:
+  std::string name() const override { return "friction_directions"; }
+  void onContact(ContactContext& ctx, dSurfaceParameters&) override {
+    if (ctx.fdir1.squaredNorm() == 0) return;
+    if (std::abs(ctx.normal.z()) < 0.3) face.push_back(ctx.fdir1);
+    if (std::abs(ctx.normal.z()) > 0.95) floor.push_back({ctx.fdir1, ctx.heading});
+  }
+  std::vector<Vec3> face;
+  std::vector<std::pair<Vec3, Vec3>> floor;  // (fdir1, heading in the contact plane)
+};
+
+TEST(TreelsFriction, APyramidOnAFaceAheadRunsUpTheFace) {
+  // ODE's friction pyramid bounds friction along each of its two directions separately, so along
+  // its diagonal friction reaches 1.41 mu N. On a floor its first direction is the heading. On a
+  // face the robot drives into, the heading's projection is only the remnant of a small yaw: a
+  // direction that turned the pyramid about the face's normal and let a Detailed robot at mu 0.5
+  // hold itself up a step's face on 0.69 N per 1 N pressed (2026-11-27). The first direction is
+  // the way the wheels roll instead: up the face, the heading on the floor.
+  WorldConfig c = flatWorld();
+  c.terrain.boxes.push_back({"wall", Vec3(0.20, 0, 0.1), Vec3(0.05, 1.0, 0.2), 0, 0, "wall"});
+  World w(c);
+  auto seen = std::make_shared<FrictionDirections>();
+  w.addEffect(seen);
+  Robot& r = w.addRobot(loadLevel("detailed"), {0, 0, 2.0 * M_PI / 180}, "sbot_0");  // 2 deg off square
+  r.setSpeed(30, 30);
+  runFor(w, 3.0);
+  ASSERT_GT(seen->face.size(), 50u) << "the front wheels never pressed against the wall";
+  for (const Vec3& d : seen->face) ASSERT_GT(std::abs(d.z()), 0.98) << "on the face: " << d.transpose();
+  ASSERT_GT(seen->floor.size(), 100u);
+  for (const auto& [d, heading] : seen->floor) ASSERT_GT(std::abs(d.dot(heading)), 0.999) << "on the floor";
 }
 
 TEST(TreelsFriction, OnlySimpleCalibratesItsOwn) {

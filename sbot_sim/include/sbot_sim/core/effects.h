@@ -38,10 +38,11 @@ struct ContactContext {
   /// Heading of the robot involved (a's if both), projected on the contact plane and normalised;
   /// zero when no robot is involved.
   Vec3 heading = Vec3::Zero();
-  /// First friction direction of ODE's friction pyramid: the robot's heading for robot-terrain
-  /// contacts (so that friction does not depend on the world axes), zero (ODE's default) for
-  /// robot-robot ones. Effects may change it and mu / mu2 in the surface; a non-zero value is
-  /// copied into the contact with dContactFDir1.
+  /// First friction direction of ODE's friction pyramid: for robot-terrain contacts the way the
+  /// robot's wheels roll in the contact plane (axle x normal: the heading on floors and ramps, up
+  /// a face the robot is pressed against), so that friction does not depend on the world axes;
+  /// zero (ODE's default) for robot-robot ones. Effects may change it and mu / mu2 in the surface;
+  /// a non-zero value is copied into the contact with dContactFDir1.
   Vec3 fdir1 = Vec3::Zero();
 };
 

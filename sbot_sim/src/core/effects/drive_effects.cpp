@@ -346,8 +346,9 @@ void TrackFrictionAnisotropyEffect::onContact(ContactContext& ctx, dSurfaceParam
   const double ratio = param("lateral_ratio");
   const bool track = (ctx.robot_a && ctx.material_a == "track") || (ctx.robot_b && ctx.material_b == "track");
   if (!track || ratio == 1.0 || ctx.heading.squaredNorm() == 0) return;
-  // The pyramid's first direction along the track (the core's default on terrain), the second across.
-  ctx.fdir1 = ctx.heading;
+  // The pyramid's first direction along the track (the core's own on terrain: the way the wheels
+  // roll), the second across; robot-robot contacts have none from the core and take the heading.
+  if (ctx.fdir1.squaredNorm() == 0) ctx.fdir1 = ctx.heading;
   surface.mode |= dContactMu2;
   surface.mu2 = surface.mu * ratio;
 }
