@@ -66,9 +66,8 @@ const std::string kGround = "ground";
 /// the contact plane (axle x normal). On floors and ramps that is the heading; on a face the robot
 /// is pressed against, it is up the face. The heading's projection there is only a sideways
 /// remnant of the robot's yaw, and a pyramid turned by it let friction hold up to 1.4 mu N up the
-/// face (the box's diagonal): 2026-11-27, a Detailed robot at mu 0.5 reared up a 24 mm step on
-/// 0.69 N of vertical friction per 1 N pressed. Contacts on the robot's flanks (normal along the
-/// axle) keep the heading.
+/// face (the box's diagonal; measured 2026-11-27 at a step's face at mu 0.5: 0.69 N up per 1 N
+/// pressed). Contacts on the robot's flanks (normal along the axle) keep the heading.
 Vec3 rollingDirection(const Vec3& axle, const Vec3& normal, const Vec3& heading_in_plane) {
   const Vec3 roll = axle.cross(normal);
   if (roll.norm() < 0.5) return heading_in_plane;
