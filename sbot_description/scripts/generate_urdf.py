@@ -77,6 +77,7 @@ def resolve_level(table, level):
 
 # Physical quantities that must be positive wherever they appear in a level (key names of the table).
 POSITIVE_KEYS = ("mass_kg", "radius_m", "height_m", "length_m", "width_m", "box_m", "inertia_kgm2")
+TOOTH_SHAPES = ("box", "cylinder")
 
 
 def check_level(source, node, path):
@@ -87,6 +88,8 @@ def check_level(source, node, path):
         for k, v in node.items():
             where = "%s.%s" % (path, k)
             check_level(source, v, where)
+            if k == "tooth_shape" and v not in TOOTH_SHAPES:
+                raise SystemExit("%s: %s: expected one of %s, found %r" % (source, where, ", ".join(TOOTH_SHAPES), v))
             if k in POSITIVE_KEYS or k.endswith("radius_m"):
                 for i, x in enumerate(v if isinstance(v, list) else [v]):
                     if isinstance(x, (int, float)) and not isinstance(x, bool) and not x > 0:
@@ -336,11 +339,17 @@ def build(level, p):
             h, n = w["tooth_height_m"], int(w["teeth"])
             shapes = [cylinder(r - h, w["width_m"], rpy=(HALF_PI, 0, 0), colour="track_black")]
             rho = r - h / 2.0
+            round_teeth = w.get("tooth_shape", "box") == "cylinder"
             for k in range(n):
                 phi = 2.0 * math.pi * k / n
-                shapes.append(box([h, w["width_m"], w["tooth_width_m"]],
-                                  (rho * math.cos(phi), 0, rho * math.sin(phi)), (0, -phi, 0),
-                                  colour="track_black"))
+                if round_teeth:  # along the axle, its outside on the wheel's radius
+                    a = w["tooth_width_m"] / 2.0
+                    shapes.append(cylinder(a, w["width_m"], ((r - a) * math.cos(phi), 0, (r - a) * math.sin(phi)),
+                                           (HALF_PI, 0, 0), colour="track_black"))
+                else:
+                    shapes.append(box([h, w["width_m"], w["tooth_width_m"]],
+                                      (rho * math.cos(phi), 0, rho * math.sin(phi)), (0, -phi, 0),
+                                      colour="track_black"))
         else:
             raise ValueError(w["shape"])
         rb.link(name, m, (0, 0, 0), inertia, shapes)

@@ -180,12 +180,7 @@ def value_errors(u, sc, p, level):
     per_track = len(names) // 2
     for n in names:
         w = p["wheels"]["center"] if n in ("left_wheel", "right_wheel") else p["wheels"]["front_rear"]
-        cols = u.collisions(n)
-        if w["shape"] == "sphere":
-            r = cols[0][1]["radius"]
-        else:  # core cylinder + teeth: outer radius = max distance of a tooth's outer face centre
-            r = max(math.hypot(c[2][0], c[2][2]) + c[1]["size"][0] / 2.0 for c in cols if c[0] == "box")
-        chk(n + " radius", r, w["radius_m"])
+        chk(n + " radius", outer_radius(u.collisions(n)), w["radius_m"])
         xyz, _ = u.origin(n + "_joint")
         chk(n + " lateral offset", abs(xyz[1]), w["y_m"])
         chk(n + " x", abs(xyz[0]), w["x_m"])
@@ -248,6 +243,19 @@ def value_errors(u, sc, p, level):
     if sc["level"] != level:
         err.append("%s sidecar level %r" % (level, sc["level"]))
     return err
+
+
+def outer_radius(cols):
+    """A wheel's radius from its collision shapes: the furthest any shape reaches from the axle (a
+    sphere's radius; a teethed wheel's core cylinder, box teeth or round teeth)."""
+    reach = {"sphere": lambda c: c[1]["radius"], "cylinder": lambda c: math.hypot(c[2][0], c[2][2]) + c[1]["radius"],
+             "box": lambda c: math.hypot(c[2][0], c[2][2]) + c[1]["size"][0] / 2.0}
+    return max(reach[c[0]](c) for c in cols)
+
+
+def teeth_of(cols):
+    """A teethed wheel's teeth: every shape but the core cylinder on the axle."""
+    return [c for c in cols if math.hypot(c[2][0], c[2][2]) > 1e-9]
 
 
 def write_changed_table(tmp, level, path, value):
@@ -364,7 +372,9 @@ class TestDescription(unittest.TestCase):
                  ("medium", ["wheels", "center", "radius_m"], 0.0,
                   "levels.medium.wheels.center.radius_m: expected a number > 0"),
                  ("simple", ["chassis", "com_m"], [0.0, float("nan"), 0.0],
-                  "levels.simple.chassis.com_m[1]: expected a finite number")]
+                  "levels.simple.chassis.com_m[1]: expected a finite number"),
+                 ("detailed", ["wheels", "front_rear", "tooth_shape"], "hexagon",
+                  "levels.detailed.wheels.front_rear.tooth_shape: expected one of box, cylinder, found 'hexagon'")]
         for level, path, value, message in cases:
             with tempfile.TemporaryDirectory() as tmp:
                 tpath = write_changed_table(tmp, level, path, value)
@@ -374,6 +384,34 @@ class TestDescription(unittest.TestCase):
                 self.assertNotEqual(r.returncode, 0, ".".join(path))
                 self.assertIn(message, r.stderr)
                 self.assertIn(tpath, r.stderr)
+
+    def test_round_teeth_reach_the_wheels_radius(self):
+        """tooth_shape: cylinder gives every tooth as a cylinder along the axle, its outside on the
+        wheel's radius, as many as `teeth`; the values and the URDF check hold as for box teeth."""
+        with tempfile.TemporaryDirectory() as tmp:
+            table = copy.deepcopy(TABLE)
+            for key in ("center", "front_rear"):
+                table["levels"]["detailed"]["wheels"][key]["tooth_shape"] = "cylinder"
+            tpath = os.path.join(tmp, "table.yaml")
+            with open(tpath, "w") as fh:
+                yaml.safe_dump(table, fh)
+            out = os.path.join(tmp, "out")
+            generate_to(out, tpath)
+            u = Urdf(os.path.join(out, "detailed.urdf"))
+            sc = load_sidecar(os.path.join(out, "detailed.sbot.yaml"))
+            p = gen.resolve_level(table, "detailed")
+            self.assertEqual(value_errors(u, sc, p, "detailed"), [])
+            for name, key in (("left_wheel", "center"), ("right_wheel_front", "front_rear")):
+                w = p["wheels"][key]
+                teeth = teeth_of(u.collisions(name))
+                self.assertEqual(len(teeth), int(w["teeth"]), name)
+                for shape, attrs, xyz, rpy in teeth:
+                    self.assertEqual(shape, "cylinder", name)
+                    self.assertAlmostEqual(attrs["radius"], w["tooth_width_m"] / 2.0, places=9)
+                    self.assertAlmostEqual(math.hypot(xyz[0], xyz[2]) + attrs["radius"], w["radius_m"], places=7)
+                    self.assertAlmostEqual(rpy[0], math.pi / 2, places=6)  # axis along the axle (y)
+            r = subprocess.run([CHECK_URDF, os.path.join(out, "detailed.urdf")], capture_output=True, text=True)
+            self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
 
     def test_d_total_mass_and_fast_scaling(self):
         for lv in LEVELS:
@@ -488,11 +526,9 @@ class TestDescription(unittest.TestCase):
                 cols = u.collisions(jn[:-len("_joint")])
                 if cols[0][0] == "sphere":
                     r_roll = cols[0][1]["radius"]
-                else:  # teethed: rolls on the polygon of tooth faces
-                    teeth = [c for c in cols if c[0] == "box"]
-                    n = len(teeth)
-                    r_out = max(math.hypot(c[2][0], c[2][2]) + c[1]["size"][0] / 2.0 for c in teeth)
-                    r_roll = r_out * math.sin(math.pi / n) / (math.pi / n)
+                else:  # teethed: rolls on the polygon of its teeth's outsides
+                    n = len(teeth_of(cols))
+                    r_roll = outer_radius(cols) * math.sin(math.pi / n) / (math.pi / n)
                 v = omega * r_roll
                 self.assertLess(abs(v - v_cmd) / v_cmd, 0.03, "%s %s: %g vs %g" % (lv, jn, v, v_cmd))
 
