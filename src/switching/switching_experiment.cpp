@@ -163,12 +163,7 @@ int main(int argc, char** argv) {
     const auto dot = o.route.rfind(".yaml");
     o.route = (dot == std::string::npos ? o.route : o.route.substr(0, dot)) + ".route.yaml";
   }
-  try {  // before any run: the results would be lost at the end
-    sbot::makeOutputDirectory(o.out);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "switching_experiment: --out: %s\n", e.what());
-    return 2;
-  }
+  sbot_tools::requireOutputDirectory("switching_experiment", "--out", o.out);  // before any run
   try {
     sbot::loadScenario(o.scenario);
     loadRoute(o.route);

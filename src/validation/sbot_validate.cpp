@@ -748,12 +748,8 @@ int main(int argc, char** argv) {
   }
   for (const std::string& level : kAllLevels)  // before any work: every trial of that level would fail on it
     sbot_tools::requireLevel("sbot_validate", "model description of level '" + level + "' (or $SBOT_DESCRIPTION_DIR)", level);
-  try {  // before any work: a report that cannot be saved would be found out only at the end
-    sbot::makeOutputDirectory(o.out);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "sbot_validate: --out: %s\n", e.what());
-    return 2;
-  }
+  // Before any work: a report that cannot be saved would be found out only at the end.
+  sbot_tools::requireOutputDirectory("sbot_validate", "--out", o.out);
 
   RtmRuns rtm;
   if (want("4.4")) rtm = measureRtm(o);

@@ -10,6 +10,7 @@
 #include <exception>
 #include <string>
 
+#include "sbot_sim/core/output_files.h"
 #include "sbot_sim/core/robot_description.h"
 
 namespace sbot_tools {
@@ -43,6 +44,18 @@ inline void requireLevel(const char* tool, const std::string& what, const std::s
     sbot::loadLevel(level);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s: %s: %s\n", tool, what.c_str(), e.what());
+    std::exit(2);
+  }
+}
+
+/// The tool's output directory `dir` (option `option`) is created with its parents and can be
+/// written (sbot::makeOutputDirectory), checked before the work whose results it will hold: else
+/// "TOOL: OPTION: why" and exit status 2.
+inline void requireOutputDirectory(const char* tool, const std::string& option, const std::string& dir) {
+  try {
+    sbot::makeOutputDirectory(dir);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s: %s\n", tool, option.c_str(), e.what());
     std::exit(2);
   }
 }
