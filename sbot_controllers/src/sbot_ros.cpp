@@ -33,6 +33,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -438,11 +439,18 @@ void initSwarmBot(void (*errorHandler)(const char*), void (*warningHandler)(cons
   g->spinner->start();
   g->speed_pub = g->nh->advertise<sbot_msgs::TrackSpeed>("cmd_speed", 10);
   g->speaker_pub = g->nh->advertise<std_msgs::Float64>("speaker", 10, true);
-  const std::string probe = g->nh->resolveName("set_gripper");
-  if (!ros::service::waitForService(probe, ros::Duration(30.0))) {
-    report(true, "initSwarmBot: %s not available after 30 s: is the simulator running and the namespace "
-                 "right (SBOT_NAMESPACE, __ns:=, ROS_NAMESPACE)?", probe.c_str());
-    return;
+  // Every service the API calls: the simulator advertises them one after another, so one being up
+  // does not mean the others are (a first setTurretRotation right after set_gripper appeared failed,
+  // 2026-11-27, rostest sbot_api_avoidance). 30 s for them all.
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(30.0);
+  for (const char* service : {"set_gripper", "set_side_arm", "set_leds", "set_sampling_rate", "set_turret"}) {
+    const std::string probe = g->nh->resolveName(service);
+    const double left = std::max(0.1, (deadline - ros::WallTime::now()).toSec());
+    if (!ros::service::waitForService(probe, ros::Duration(left))) {
+      report(true, "initSwarmBot: %s not available after 30 s: is the simulator running and the namespace "
+                   "right (SBOT_NAMESPACE, __ns:=, ROS_NAMESPACE)?", probe.c_str());
+      return;
+    }
   }
   const auto until = Clock::now() + std::chrono::seconds(5);
   sbot_controllers::pollUntil([] { return g->speed_pub.getNumSubscribers() > 0; }, until);
