@@ -385,33 +385,36 @@ class TestDescription(unittest.TestCase):
                 self.assertIn(message, r.stderr)
                 self.assertIn(tpath, r.stderr)
 
-    def test_round_teeth_reach_the_wheels_radius(self):
-        """tooth_shape: cylinder gives every tooth as a cylinder along the axle, its outside on the
-        wheel's radius, as many as `teeth`; the values and the URDF check hold as for box teeth."""
-        with tempfile.TemporaryDirectory() as tmp:
-            table = copy.deepcopy(TABLE)
-            for key in ("center", "front_rear"):
-                table["levels"]["detailed"]["wheels"][key]["tooth_shape"] = "cylinder"
-            tpath = os.path.join(tmp, "table.yaml")
-            with open(tpath, "w") as fh:
-                yaml.safe_dump(table, fh)
-            out = os.path.join(tmp, "out")
-            generate_to(out, tpath)
-            u = Urdf(os.path.join(out, "detailed.urdf"))
-            sc = load_sidecar(os.path.join(out, "detailed.sbot.yaml"))
-            p = gen.resolve_level(table, "detailed")
-            self.assertEqual(value_errors(u, sc, p, "detailed"), [])
-            for name, key in (("left_wheel", "center"), ("right_wheel_front", "front_rear")):
-                w = p["wheels"][key]
-                teeth = teeth_of(u.collisions(name))
-                self.assertEqual(len(teeth), int(w["teeth"]), name)
-                for shape, attrs, xyz, rpy in teeth:
-                    self.assertEqual(shape, "cylinder", name)
-                    self.assertAlmostEqual(attrs["radius"], w["tooth_width_m"] / 2.0, places=9)
-                    self.assertAlmostEqual(math.hypot(xyz[0], xyz[2]) + attrs["radius"], w["radius_m"], places=7)
-                    self.assertAlmostEqual(rpy[0], math.pi / 2, places=6)  # axis along the axle (y)
-            r = subprocess.run([CHECK_URDF, os.path.join(out, "detailed.urdf")], capture_output=True, text=True)
-            self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+    def test_both_tooth_shapes_reach_the_wheels_radius(self):
+        """tooth_shape: cylinder (the table's) gives every tooth as a cylinder along the axle, box as
+        a box across the rim; either way as many as `teeth`, their outsides on the wheel's radius,
+        and the values and the URDF check hold."""
+        for tooth_shape in ("cylinder", "box"):
+            with tempfile.TemporaryDirectory() as tmp:
+                table = copy.deepcopy(TABLE)
+                for key in ("center", "front_rear"):
+                    table["levels"]["detailed"]["wheels"][key]["tooth_shape"] = tooth_shape
+                tpath = os.path.join(tmp, "table.yaml")
+                with open(tpath, "w") as fh:
+                    yaml.safe_dump(table, fh)
+                out = os.path.join(tmp, "out")
+                generate_to(out, tpath)
+                u = Urdf(os.path.join(out, "detailed.urdf"))
+                sc = load_sidecar(os.path.join(out, "detailed.sbot.yaml"))
+                p = gen.resolve_level(table, "detailed")
+                self.assertEqual(value_errors(u, sc, p, "detailed"), [], tooth_shape)
+                for name, key in (("left_wheel", "center"), ("right_wheel_front", "front_rear")):
+                    w = p["wheels"][key]
+                    teeth = teeth_of(u.collisions(name))
+                    self.assertEqual(len(teeth), int(w["teeth"]), name)
+                    for shape, attrs, xyz, rpy in teeth:
+                        self.assertEqual(shape, tooth_shape, name)
+                        if shape == "cylinder":
+                            self.assertAlmostEqual(attrs["radius"], w["tooth_width_m"] / 2.0, places=9)
+                            self.assertAlmostEqual(rpy[0], math.pi / 2, places=6)  # axis along the axle (y)
+                        self.assertAlmostEqual(outer_radius([(shape, attrs, xyz, rpy)]), w["radius_m"], places=7, msg=name)
+                r = subprocess.run([CHECK_URDF, os.path.join(out, "detailed.urdf")], capture_output=True, text=True)
+                self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
 
     def test_d_total_mass_and_fast_scaling(self):
         for lv in LEVELS:
