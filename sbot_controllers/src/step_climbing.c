@@ -5,8 +5,10 @@
  *                               its jaws, creeps forward until the optical barrier sees the other
  *                               robot, closes), then reverses. When it senses the step (its tracks
  *                               load up or its body tilts: the rear treels touch the step face) it
- *                               lowers its gripper arm and keeps reversing: braced on the held robot,
- *                               its rear climbs the step face instead of tipping it over. It then
+ *                               raises its gripper arm and keeps reversing: braced on the held robot's
+ *                               weight it tips forward about its own front wheels and its rear rises
+ *                               onto the step (lowering the arm would have to lift its front about
+ *                               its rear, which the arm's torque cannot). It then
  *                               levels the arm, reverses until the held robot is at the step (timed
  *                               from the distance between them), raises the arm to lift the held
  *                               robot's rear and pulls it up, and stops on the plateau.
@@ -35,10 +37,10 @@
 #define LOAD_TORQUE 15      /* [torque units] mean track torque (backwards) that means "pushing" */
 #define LOAD_SAMPLES 2      /* consecutive loaded samples to call it an event */
 #define STEP_TILT 3         /* [deg] tilt change that means the rear treels are on the step face */
-#define LIFT_S 6.0          /* [s] arm down while the holder climbs (the held robot stands) */
+#define LIFT_S 6.0          /* [s] arm raised while the holder climbs (the held robot stands) */
 #define LEVEL_S 3.0         /* [s] arm level: reversing until the held robot reaches the step */
 #define RAISE_S 2.5         /* [s] arm up: lifting the held robot's rear onto the step */
-#define ARM_DOWN (-45)      /* [deg] */
+#define ARM_LIFT 20         /* [deg] lifts the holder's own rear */
 #define ARM_UP 50           /* [deg] */
 #define GRIP_BARRIER 60     /* optical barrier (0..700) at which the other robot is between the jaws */
 #define LEVEL_TILT 4        /* [deg] "level" */
@@ -135,14 +137,14 @@ static int grip(Sample *s) {
   return 1;
 }
 
-/* The holder's arm after it senses the step: down (braced on the held robot, its rear climbs the
- * step face), level (reversing until the held robot is at the step), up (lifting the held robot's
- * rear onto the step). */
+/* The holder's arm after it senses the step: raised a little (braced on the held robot, its own rear
+ * rises onto the step), level (reversing until the held robot is at the step), up (lifting the held
+ * robot's rear onto the step). */
 typedef struct {
   int elevation;   /* [deg] */
   double seconds;  /* [s] simulated */
 } ArmStep;
-static const ArmStep kArmSchedule[] = {{ARM_DOWN, LIFT_S}, {0, LEVEL_S}, {ARM_UP, RAISE_S}};
+static const ArmStep kArmSchedule[] = {{ARM_LIFT, LIFT_S}, {0, LEVEL_S}, {ARM_UP, RAISE_S}};
 #define ARM_STEPS ((int)(sizeof(kArmSchedule) / sizeof(kArmSchedule[0])))
 
 static void holder(void) {

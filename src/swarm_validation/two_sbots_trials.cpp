@@ -105,6 +105,7 @@ StepResult stepBackward(const std::string& level, double h, int trial, bool pair
   c.seed = 8000 + trial;
   c.terrain.type = TerrainConfig::Type::Composite;
   c.terrain.boxes.push_back({"step", Vec3(-1.0, 0, h / 2), Vec3(2.0, 1.0, h), 0, 0, "ground"});
+  c.contact.material_mu["track"] = validation::kLabFloorTrackMu;  // Table 4.3's apparatus
   validation::applyStudyKnobs(c);  // the solver study knobs, as sbot_validate
   World w(c);
   std::mt19937 rng(trial * 977 + static_cast<int>(h * 1e4));
@@ -123,7 +124,10 @@ StepResult stepBackward(const std::string& level, double h, int trial, bool pair
   StepResult res{"fail"};
   bool toppled = false;
   const int speed = -15;
-  constexpr int kLiftElevation = -45;  // [deg] arm down: the holder pushes its own rear up
+  // [deg] arm up: braced on the held robot's weight, the holder tips forward about its own front
+  // wheels and its rear rises onto the step (0.16 N m against the gripper's 0.5; the other way, arm
+  // down, would have to lift its front about its rear, ~0.4 N m, and does not move).
+  constexpr int kLiftElevation = 20;
   int phase = 0;
   double phase_t = 0;
   const double T = 40.0;
@@ -131,7 +135,7 @@ StepResult stepBackward(const std::string& level, double h, int trial, bool pair
     const double t = i * c.step;
     const Pose pa = a.basePose();
     if (pair) {
-      // Phase 0: reverse to the step. 1: arm down (lifts the holder's rear) while reversing.
+      // Phase 0: reverse to the step. 1: arm up (lifts the holder's rear) while reversing.
       // 2: holder's rear wheels on the step: arm back to level, keep reversing. 3: the held robot at
       // the step: arm up (lifts it) and pull.
       const Pose pb = b->basePose();

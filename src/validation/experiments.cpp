@@ -27,11 +27,12 @@ namespace sbot {
 namespace validation {
 namespace {
 
-WorldConfig configFor(const RobotDescription& d, std::uint64_t seed) {
+WorldConfig configFor(const RobotDescription& d, std::uint64_t seed, const Drive& drive = Drive()) {
   WorldConfig c;
   c.step = d.recommended_step;
   c.gravity = d.gravity;
   c.seed = seed;
+  if (drive.track_mu > 0) c.contact.material_mu["track"] = drive.track_mu;  // the apparatus' floor
   // The World raises the quickstep iterations to the level's need (RobotDescription::
   // solver_iterations). Medium: 25, where its force-limited treels' row converges. Detailed: 40: at
   // 20 the 22-body model jitters at rest (~0.5 rad/s), sits nose-down and topples off steps it
@@ -204,7 +205,7 @@ TrialWorld gapWorld(const std::string& level, double gap_m, int trial, const Dri
   const RobotDescription& d = loadLevel(level);
   const double s = lengthScale(level);
   Jitter j("gap" + level, gap_m, trial);
-  TrialWorld t{configFor(d, 1000 + trial)};
+  TrialWorld t{configFor(d, 1000 + trial, drive)};
   const double top = 0.10;
   // The half-size Fast robot crosses the gap halved, as its terrain is halved in 4.2.2 "to retain
   // comparable conditions" (the seed's Fast passing 6 cm, longer than itself, needs it too).
@@ -270,7 +271,7 @@ TrialWorld stepWorld(const std::string& level, double height_m, bool backward, i
   const RobotDescription& d = loadLevel(level);
   const double s = lengthScale(level);
   Jitter j(std::string("step") + (backward ? "b" : "f") + level, height_m, trial);
-  TrialWorld t{configFor(d, 2000 + trial)};
+  TrialWorld t{configFor(d, 2000 + trial, drive)};
   t.world.terrain.type = TerrainConfig::Type::Composite;
   t.world.terrain.boxes.push_back(block(0.0, 1.0, height_m, "step"));
   const double x0 = -0.075 * s + j.uniform(-0.005, 0.005) * s;
@@ -311,8 +312,8 @@ void onPolystyrene(WorldConfig& c) { c.contact.material_mu["track"] = kPolystyre
 Outcome slopeHoldClimbTrial(const std::string& level, double angle_rad, bool backward, int trial, const Drive& drive) {
   const RobotDescription& d = loadLevel(level);
   Jitter j(std::string("slope") + (backward ? "b" : "f") + level, angle_rad, trial);
-  WorldConfig c = configFor(d, 3000 + trial);
-  onPolystyrene(c);
+  WorldConfig c = configFor(d, 3000 + trial, drive);
+  if (drive.track_mu <= 0) onPolystyrene(c);
   World w(c);
   // A tilted gravity is an infinite slope rising toward +x.
   const double g = c.gravity;
@@ -358,7 +359,7 @@ TrialWorld uphillWorld(const std::string& level, double angle_rad, int trial, co
   const RobotDescription& d = loadLevel(level);
   const double s = lengthScale(level);
   Jitter j("uphill" + level, angle_rad, trial);
-  TrialWorld t{configFor(d, 4000 + trial)};
+  TrialWorld t{configFor(d, 4000 + trial, drive)};
   t.world.terrain.type = TerrainConfig::Type::Composite;
   t.world.terrain.boxes.push_back(ramp(Vec3(0, 0, 0), angle_rad, 0.6 * s, "ramp"));
   const double yaw0 = j.uniform(-0.05, 0.05);
@@ -439,7 +440,7 @@ TrialWorld downhillWorld(const std::string& level, double angle_rad, int trial, 
   const RobotDescription& d = loadLevel(level);
   const double s = lengthScale(level);
   Jitter j("downhill" + level, angle_rad, trial);
-  TrialWorld t{configFor(d, 5000 + trial)};
+  TrialWorld t{configFor(d, 5000 + trial, drive)};
   t.world.terrain.type = TerrainConfig::Type::Composite;
   const double L = downhillRampLength(s);
   const double H = L * std::sin(angle_rad);

@@ -92,6 +92,18 @@ class Fields {
       fail_(where_ + ": field '" + k + "' expects a finite number, found '" + t + "'");
     return v;
   }
+  /// The treels' Coulomb coefficient on a table's terrain: a number in (0, 100], or `lab_floor`
+  /// (kLabFloorTrackMu); fallback when the field is absent (0: the experiment's own).
+  double trackMu(const std::string& k, double fallback) {
+    const std::string t = text(k, false, "");
+    if (t.empty()) return fallback;
+    if (t == "lab_floor") return kLabFloorTrackMu;
+    char* end = nullptr;
+    const double v = std::strtod(t.c_str(), &end);
+    if (end == t.c_str() || *end != '\0' || !(v > 0 && v <= 100))
+      fail_(where_ + ": field '" + k + "' expects a friction coefficient in (0, 100] or lab_floor, found '" + t + "'");
+    return v;
+  }
   bool flag(const std::string& k) {
     const std::string t = text(k, false, "false");
     if (t != "true" && t != "false") fail_(where_ + ": field '" + k + "' expects true or false, found '" + t + "'");
@@ -156,6 +168,7 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
   const std::string level = f.text("level", false);
   const std::string variant = f.text("variant", false);
   const double speed_units = f.number("speed_units", false, kSlowUnits);
+  const double track_mu = f.trackMu("track_mu", 0);
   t.variant_header = f.text("variant_header", false);
   if (f.has("param")) t.param = readFormat(f.node("param"), at + ", param", t.param.header, fail);
   t.references = f.list("references");
@@ -191,6 +204,7 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
       fail(cat + ": speed_units expects a whole number of setSpeed units in [1, 70] (0.28 cm/s each), found " +
            std::to_string(units));
     c.speed_units = static_cast<int>(units);
+    c.track_mu = cf.trackMu("track_mu", track_mu);
     const ExperimentKind* kind = findExperimentKind(c.experiment);
     if (!kind || kind->labels.empty())
       fail(cat + ": experiment '" + c.experiment + "' is not one of " + experimentKindNames(true));

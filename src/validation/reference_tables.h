@@ -32,6 +32,7 @@ struct ReferenceCell {
   double param = 0;        ///< the kind's parameter, in its unit (gap width m, slope deg, ramp rad)
   std::string variant;     ///< a row label beside the parameter ("backward"), may be empty
   int speed_units = kSlowUnits;  ///< the drive's setSpeed units (Drive; the seed's 2.8 cm/s)
+  double track_mu = 0;           ///< the treels' mu on the terrain (Drive::track_mu; 0: the experiment's own)
   std::vector<ReferenceValue> references;  ///< one per ReferenceTable::references; [0] is compared
 };
 

@@ -16,10 +16,12 @@
 // created with its parents and checked before any trial; a report that fails to save at the end is
 // still printed on stdout).
 //
-//   sbot_validate [--trace] [--index N] [--speed UNITS] --trial KIND LEVEL PARAM    one trial, printed
+//   sbot_validate [--trace] [--index N] [--speed UNITS] [--track-mu MU|lab_floor] --trial KIND LEVEL PARAM    one trial, printed
 //     (tuning aid); --trace prints the robot's state every 0.1 s (pose, attitude, wheel load, track
 //     speeds, turret angle, gripper tip); --index N runs the cell's trial N (its start
-//     perturbation, as in the report; default 0); --speed: setSpeed units (default 10, 2.8 cm/s)
+//     perturbation, as in the report; default 0); --speed: setSpeed units (default 10, 2.8 cm/s);
+//     --track-mu: the treels' mu on the terrain, e.g. lab_floor for Tables 4.2/4.3's cells (default:
+//     the experiment's own, 1.0)
 // KIND: gap, step, stepb, slope, slopeb, uphill, downhill, rough, rtm, speed (PARAM: m, m, m, deg,
 // deg, rad, rad, HR in cm, simulated s, setSpeed units of the compatibility check; ranges in
 // experimentKinds(), experiments.h).
@@ -368,9 +370,12 @@ void writePairRows(std::ostream& md, const Options& o, Tally& hw) {
   const ModalCell ms = modalCell("topple", single), mp = modalCell("pass", pair);
   const bool single_ok = ms.ok, pair_ok = mp.ok;
   md << "## 4.1.3 - two-robot step passing, going backwards (Detailed)\n\n"
-     << "A 32 mm step; the holder nearest the step lowers its gripper arm when its rear reaches the step and "
-        "pulls the held robot over (phases from ground truth here; the same procedure driven by the robots' "
-        "own sensors through sbot.h is sbot_controllers/src/step_climbing.c, rostest test/two_sbots_step.test).\n\n"
+     << "A 32 mm step on Table 4.3's lab floor (treels mu " << fmt(v::kLabFloorTrackMu, 3) << "); the holder nearest "
+        "the step raises its gripper arm 20 deg when its rear reaches the step (braced on the held robot, it tips "
+        "forward about its front wheels and its rear rises onto the step), levels it and reverses on, then raises it "
+        "to 50 deg to pull the held robot over (phases from ground truth here; the same procedure driven by the "
+        "robots' own sensors through sbot.h is sbot_controllers/src/step_climbing.c, rostest "
+        "test/two_sbots_step.test, on the simulator's default floor).\n\n"
      << "| step | robots | real s-bots | seed sim | ours | match |\n|---|---|---|---|---|---|\n"
      << "| 32 mm | single s-bot | topple | topple | " << ms.text << " (" << summary(single) << ") | " << mark("4.1.3 32 mm single s-bot", single_ok, hw)
      << " |\n"
@@ -543,7 +548,7 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
   const std::vector<Outcome> res = v::runParallel(kinds * cells * o.trials, o.jobs, [&](int i) {
     const int run = i / (cells * o.trials), cell = (i / o.trials) % cells;
     const v::ReferenceCell& c = t.cells[cell];
-    return v::findExperimentKind(run == 0 ? c.experiment : t.companion)->run(c.level, c.param, i % o.trials, v::Drive{c.speed_units});
+    return v::findExperimentKind(run == 0 ? c.experiment : t.companion)->run(c.level, c.param, i % o.trials, v::Drive{c.speed_units, c.track_mu});
   });
   auto outcomes = [&](int run, int cell) {
     const auto first = res.begin() + (run * cells + cell) * o.trials;
@@ -664,6 +669,10 @@ int main(int argc, char** argv) {
     else if (a == "--trace") trace = true;  // with --trial (before it): the robot's state every 0.1 s
     else if (a == "--index") index = args.count(0, 999);  // with --trial (before it): the cell's trial N
     else if (a == "--speed") drive.units = args.count(1, 70);  // with --trial (before it): setSpeed units
+    else if (a == "--track-mu") {  // with --trial (before it): the treels' mu on the terrain (a table's track_mu)
+      const std::string m = args.value();
+      drive.track_mu = m == "lab_floor" ? v::kLabFloorTrackMu : sbot_tools::numberArg(args.tool(), "--track-mu", m, 1e-6, 100);
+    }
     else if (a == "--scenario") scenario_file = args.value();  // with --trial (before it): write, do not run
     else if (a == "--trial") {  // --trial KIND LEVEL PARAM: one trial, printed (tuning aid)
       const std::string kind = args.value(), level = args.value();
@@ -691,8 +700,8 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr, "usage: sbot_validate --out DIR [--quick] [--trials N] [--jobs N] [--only LIST]\n"
                            "                     [--tables YAML] [--reasons YAML] [--heightmap PNG]\n"
-                           "       sbot_validate [--trace] [--index N] [--speed UNITS] --trial KIND LEVEL PARAM\n"
-                           "       sbot_validate --scenario FILE [--index N] [--speed UNITS] --trial KIND LEVEL PARAM\n");
+                           "       sbot_validate [--trace] [--index N] [--speed UNITS] [--track-mu MU|lab_floor] --trial KIND LEVEL PARAM\n"
+                           "       sbot_validate --scenario FILE [--index N] [--speed UNITS] [--track-mu MU|lab_floor] --trial KIND LEVEL PARAM\n");
       return a == "--help" ? 0 : 2;
     }
   }

@@ -104,6 +104,11 @@ TEST(ReferenceTables, TheShippedFileHoldsTheSeedsTablesAsTallied) {
   EXPECT_EQ(ramps.key(ramps.cells[22]), "4.6 0.90 rad medium");
   EXPECT_EQ(ramps.cells[22].references[0].accepts, "slide back");
   EXPECT_EQ(by_id["4.2"]->cells[2].references[0].accepts, "fall inside");
+  // The hardware's gap and step apparatus is the lab floor; the seed simulator's tables keep 1.0.
+  for (const char* id : {"4.2", "4.3"})
+    for (const v::ReferenceCell& c : by_id[id]->cells) EXPECT_EQ(c.track_mu, v::kLabFloorTrackMu) << id;
+  for (const char* id : {"4.1", "4.5", "4.6"})
+    for (const v::ReferenceCell& c : by_id[id]->cells) EXPECT_EQ(c.track_mu, 0.0) << id;
 }
 
 TEST(ReferenceTables, EveryMismatchReasonNamesACellTheReportRuns) {
@@ -135,10 +140,23 @@ TEST(ReferenceTables, AnotherLabsTableLoadsWithItsOwnNamesAndDefaults) {
   EXPECT_EQ(table.key(table.cells[0]), "lab1 30 mm medium");
   EXPECT_EQ(table.cells[1].references[0].text, "stuck or fall inside") << "a '|' would split the Markdown table";
   EXPECT_EQ(table.cells[0].speed_units, v::kSlowUnits) << "the seed's 2.8 cm/s unless the table says otherwise";
+  EXPECT_EQ(table.cells[0].track_mu, 0.0) << "the experiment's own floor unless the table says otherwise";
   EXPECT_FALSE(table.otherSpeeds());
   EXPECT_EQ(table.value.header, "base x [cm]");
   EXPECT_EQ(table.value.text(0.0123), "1.2") << "x scale, decimals, no unit";
   EXPECT_EQ(table.param.text(0.035), "35 mm");
+}
+
+TEST(ReferenceTables, ATablesFloorFrictionIsANumberOrTheLabFloorAndACellMaySetItsOwn) {
+  std::string text = with("level: medium\n", "level: medium\n      track_mu: 0.6\n");
+  text.replace(text.find("level: basic, "), 14, "level: basic, track_mu: lab_floor, ");
+  const std::string path = writeTemp(text);
+  const v::ReferenceTables t = v::ReferenceTables::load(path, kVocabulary, "lab.yaml");
+  std::remove(path.c_str());
+  const v::ReferenceTable& table = t.report[0].table;
+  EXPECT_EQ(table.cells[0].track_mu, 0.6);
+  EXPECT_EQ(table.cells[1].track_mu, 0.6);
+  EXPECT_EQ(table.cells[2].track_mu, v::kLabFloorTrackMu);
 }
 
 TEST(ReferenceTables, MalformedFilesAreRefusedWithTheEntryAndTheProblem) {
@@ -161,6 +179,9 @@ TEST(ReferenceTables, MalformedFilesAreRefusedWithTheEntryAndTheProblem) {
         "a '|' would split the report's table"},
       {with("level: basic, ", "level: basic, speed_units: 2.5, "), "cell 2: speed_units expects a whole number of setSpeed units in [1, 70]"},
       {with("level: medium\n", "level: medium\n      speed_units: 71\n"), "cell 0: speed_units expects a whole number"},
+      {with("level: basic, ", "level: basic, track_mu: -0.5, "),
+        "cell 2: field 'track_mu' expects a friction coefficient in (0, 100] or lab_floor, found '-0.5'"},
+      {with("level: medium\n", "level: medium\n      track_mu: lab floor\n"), "found 'lab floor'"},
       {with("decimals: 1}", "decimals: 9}"), "table 'lab1', value: decimals expects a whole number from 0 to 6, found '9'"},
       {with("required: true", "required: maybe"), "field 'required' expects true or false, found 'maybe'"},
       {with("report:\n", "report:\n  - section: rtm\n"), "section 'rtm' is not a built-in section"},

@@ -35,6 +35,7 @@ TEST(ToolsCli, NonNumbersAndOutOfRangeValuesAreRefusedByName) {
   expectRefused("sbot_validate", "--trial uphill fast 2", "--trial uphill fast (ramp angle, rad) expects a number in [0, 1.5], found '2'");
   expectRefused("sbot_validate", "--trial bogus detailed 1", "found 'bogus'");
   expectRefused("sbot_validate", "--index -1 --trial gap fast 0.03", "--index expects a number in [0, 999], found '-1'");
+  expectRefused("sbot_validate", "--track-mu slippery --trial step detailed 0.02", "--track-mu expects a number in [1e-06, 100], found 'slippery'");
   expectRefused("switching_experiment", "--runs 0", "--runs expects a number in [1, 1000], found '0'");
   expectRefused("switching_experiment", "--small-gap-max nan", "--small-gap-max expects a number");
   expectRefused("two_sbots", "--angles 10,x", "--angles expects a number in [0, 90], found 'x'");
@@ -255,6 +256,13 @@ TEST(ToolsCli, ATrialIsWrittenAsAScenarioToWatch) {
   std::ifstream in(file);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("- {name: step, center: [0.5, 0, 0.0075], size: [1, 1, 0.015]"), std::string::npos) << text;
+  EXPECT_EQ(text.find("track: 0.475"), std::string::npos) << "the experiment's own floor unless asked: " << text;
+  // --track-mu lab_floor: the floor Tables 4.2 / 4.3 run on, in the scenario's materials.
+  o = run("sbot_validate", "--scenario " + file + " --track-mu lab_floor --trial stepb detailed 0.015");
+  EXPECT_EQ(o.status, 0) << o.output;
+  std::ifstream in2(file);
+  text.assign((std::istreambuf_iterator<char>(in2)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("track: 0.475"), std::string::npos) << text;
   EXPECT_NE(text.find("- {name: sbot_0, level: detailed, pose: {x: -0.07"), std::string::npos) << text;
   expectRefused("sbot_validate", "--scenario " + file + " --trial slope detailed 20",
                 "--scenario: a slope trial cannot be written as a scenario");

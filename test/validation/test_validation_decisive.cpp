@@ -34,21 +34,25 @@ v::MismatchReasons knownMismatches() {
   return v::MismatchReasons::load(std::string(SWARMBOT3D_SOURCE_DIR) + "/" + v::kMismatchReasonsFile);
 }
 
+/// Tables 4.2 and 4.3's apparatus (reference_tables.yaml: track_mu: lab_floor).
+const v::Drive kLabFloor{v::kSlowUnits, v::kLabFloorTrackMu};
+
 }  // namespace
 
 TEST(ValidationDecisive, HardwareCells) {
   const std::vector<Cell> cells{
-      {"4.2 45 mm", "pass", [] { return v::gapTrial("detailed", 0.045, 0); }},
-      {"4.2 55 mm", "fall inside", [] { return v::gapTrial("detailed", 0.055, 0); }},  // hardware: "failing to overcome it"
-      {"4.3 15 mm forward", "pass", [] { return v::stepTrial("detailed", 0.015, false, 0); }},
-      {"4.3 23 mm forward", "pass", [] { return v::stepTrial("detailed", 0.023, false, 0); }},
-      {"4.3 24 mm forward", "fail", [] { return v::stepTrial("detailed", 0.024, false, 0); }},
-      {"4.3 15 mm backward", "pass", [] { return v::stepTrial("detailed", 0.015, true, 0); }},
-      {"4.3 16 mm backward", "fail", [] { return v::stepTrial("detailed", 0.016, true, 0); }},
+      // Tables 4.2 and 4.3 run on the lab floor (reference_tables.yaml: track_mu: lab_floor).
+      {"4.2 45 mm", "pass", [] { return v::gapTrial("detailed", 0.045, 0, kLabFloor); }},
+      {"4.2 55 mm", "fall inside", [] { return v::gapTrial("detailed", 0.055, 0, kLabFloor); }},  // hardware: "failing to overcome it"
+      {"4.3 15 mm forward", "pass", [] { return v::stepTrial("detailed", 0.015, false, 0, kLabFloor); }},
+      {"4.3 23 mm forward", "pass", [] { return v::stepTrial("detailed", 0.023, false, 0, kLabFloor); }},
+      {"4.3 24 mm forward", "fail", [] { return v::stepTrial("detailed", 0.024, false, 0, kLabFloor); }},
+      {"4.3 15 mm backward", "pass", [] { return v::stepTrial("detailed", 0.015, true, 0, kLabFloor); }},
+      {"4.3 16 mm backward", "fail", [] { return v::stepTrial("detailed", 0.016, true, 0, kLabFloor); }},
       // The two cells the Detailed turret's COM is calibrated on (sbot_parameters.yaml): 12/12 each.
       {"4.1 20 deg rear uphill", "difficult",
        [] { return v::slopeHoldClimbTrial("detailed", 20 * M_PI / 180, true, 0); }},
-      {"4.3 10 mm backward", "pass", [] { return v::stepTrial("detailed", 0.010, true, 0); }},
+      {"4.3 10 mm backward", "pass", [] { return v::stepTrial("detailed", 0.010, true, 0, kLabFloor); }},
       {"4.1 30 deg rear uphill", "topple b/w",
        [] { return v::slopeHoldClimbTrial("detailed", 30 * M_PI / 180, true, 0); }},
   };
