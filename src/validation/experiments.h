@@ -101,6 +101,9 @@ void onPolystyrene(WorldConfig& c);
 /// (11/12), and the 45 mm gap passes from 0.45 (10/12; 0.4 sticks); the middle of the window in
 /// which all three hold is kept. The reference tables name it `track_mu: lab_floor`.
 constexpr double kLabFloorTrackMu = 0.475;
+/// The name that stands for kLabFloorTrackMu where a friction is given as text (reference tables,
+/// `sbot_validate --track-mu`).
+constexpr const char* kLabFloorName = "lab_floor";
 
 /// Table 4.1: placed on a slope `angle_rad` (gravity tilted) of polystyrene, first stand still 3 s
 /// with the motors holding, then climb 8 s at 2.8 cm/s. `backward`: the robot faces downhill and

@@ -97,7 +97,7 @@ class Fields {
   double trackMu(const std::string& k, double fallback) {
     const std::string t = text(k, false, "");
     if (t.empty()) return fallback;
-    if (t == "lab_floor") return kLabFloorTrackMu;
+    if (t == kLabFloorName) return kLabFloorTrackMu;
     char* end = nullptr;
     const double v = std::strtod(t.c_str(), &end);
     if (end == t.c_str() || *end != '\0' || !(v > 0 && v <= 100))

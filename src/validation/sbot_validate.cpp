@@ -671,7 +671,7 @@ int main(int argc, char** argv) {
     else if (a == "--speed") drive.units = args.count(1, 70);  // with --trial (before it): setSpeed units
     else if (a == "--track-mu") {  // with --trial (before it): the treels' mu on the terrain (a table's track_mu)
       const std::string m = args.value();
-      drive.track_mu = m == "lab_floor" ? v::kLabFloorTrackMu : sbot_tools::numberArg(args.tool(), "--track-mu", m, 1e-6, 100);
+      drive.track_mu = m == v::kLabFloorName ? v::kLabFloorTrackMu : sbot_tools::numberArg(args.tool(), "--track-mu", m, 1e-6, 100);
     }
     else if (a == "--scenario") scenario_file = args.value();  // with --trial (before it): write, do not run
     else if (a == "--trial") {  // --trial KIND LEVEL PARAM: one trial, printed (tuning aid)
