@@ -604,6 +604,7 @@ StepCost profileTrial(const std::string& level, double sim_seconds) {
   c.contacts_per_step = static_cast<double>(p.contacts) / static_cast<double>(p.steps);
   c.bodies = static_cast<int>(r.bodies().size());
   c.iterations = w.solverIterations();
+  c.step_s = w.config().step;
   return c;
 }
 

@@ -138,6 +138,14 @@ struct StepCost {
   double contacts_per_step = 0;  ///< contact joints the solver gets per step
   int bodies = 0;                ///< ODE bodies of the robot
   int iterations = 0;            ///< quickstep iterations in use
+  double step_s = 0;             ///< [s] the level's time step
+  /// The RTM if everything but ODE's solver took no time: step / the solver's wall time per step
+  /// (0 when nothing was measured). Below a target, no change outside the solver reaches it on
+  /// this machine at this iteration count.
+  double solverAloneRtm() const {
+    const double solver_s_per_step = solver * wall_us_per_step * 1e-6;
+    return solver_s_per_step > 0 ? step_s / solver_s_per_step : 0.0;
+  }
 };
 StepCost profileTrial(const std::string& level, double sim_seconds);
 
