@@ -81,7 +81,7 @@ struct Options {
 const std::vector<std::string> kLevels{"fast", "simple", "medium", "detailed"};
 /// Table 4.4: the seed's real-time multiplier per level; the target is ten times it.
 const std::map<std::string, double> kSeedRtm{{"fast", 950}, {"simple", 94}, {"medium", 31}, {"detailed", 3}};
-constexpr double kRtmTargetFactor = 10;
+double rtmTarget(const std::string& level) { return 10 * kSeedRtm.at(level); }
 /// Every model level (the core's list): the model facts cover Basic too (the seed's tables do not).
 const std::vector<std::string>& kAllLevels = sbot::modelLevels();
 constexpr int kRtmRepeats = 5;  ///< Table 4.4: runs per RTM figure, the fastest reported
@@ -249,14 +249,14 @@ void writeProfile(std::ostream& md, const std::map<std::string, v::StepCost>& pr
   auto pct = [](double f) { return fmt(100 * f, 0) + " %"; };
   for (const auto& level : kLevels) {
     if (!profile.count(level)) {  // every profiled run of it failed (sbot_validate said why on stderr)
-      md << "| " << level << " | error | | | | | | | | | | | " << kRtmTargetFactor * kSeedRtm.at(level) << " |\n";
+      md << "| " << level << " | error | | | | | | | | | | | " << rtmTarget(level) << " |\n";
       continue;
     }
     const v::StepCost& c = profile.at(level);
     md << "| " << level << " | " << c.bodies << " | " << fmt(c.contacts_per_step, 1) << " | " << c.iterations << " | "
        << fmt(c.wall_us_per_step, 1) << " | " << pct(c.solver) << " | " << pct(c.collision) << " | " << pct(c.sensors)
        << " | " << pct(c.commands) << " | " << pct(c.feedback) << " | " << fmt(c.rtm, 0) << " | "
-       << fmt(c.solverAloneRtm(), 0) << " | " << kRtmTargetFactor * kSeedRtm.at(level) << " |\n";
+       << fmt(c.solverAloneRtm(), 0) << " | " << rtmTarget(level) << " |\n";
   }
   md << "\nThe ceiling is the level's step divided by the solver's wall time per step: the RTM this machine "
         "would reach if sensors, collision detection, commands and feedback took no time. Where it is below "
@@ -454,7 +454,7 @@ void writeRtm(std::ostream& md, const Options& o, const RtmRuns& runs) {
   for (const auto& level : kLevels) {
     const v::Outcome& r = fastest.at(level)[0];
     const v::Outcome& p = fastest.at(level)[1];
-    const double target = kRtmTargetFactor * kSeedRtm.at(level);
+    const double target = rtmTarget(level);
     const int needs = sbot::loadLevel(level).solver_iterations;  // 0: the world default
     const std::string it = needs > 0 ? std::to_string(needs) : std::to_string(sbot::WorldConfig().solver_iterations) + " (default)";
     md << "| " << level << " | " << sbot::loadLevel(level).recommended_step * 1000 << " ms | " << it << " | " << kSeedRtm.at(level)
