@@ -169,7 +169,13 @@ void applyStudyKnobs(WorldConfig& c) {
     if (c.solver != "quickstep" && c.solver != "exact")
       throw ConfigError("$SBOT_VALIDATE_SOLVER", "", "expected 'quickstep' or 'exact', found '" + c.solver + "'");
   }
-  if (std::getenv("SBOT_VALIDATE_WELD")) c.lock_idle_turret = true;
+  // "1" welds, "0" or "" does not (it used to weld whenever the variable was set, even to 0).
+  if (const char* e = std::getenv("SBOT_VALIDATE_WELD")) {
+    const std::string v = e;
+    if (v != "0" && v != "1" && !v.empty())
+      throw ConfigError("$SBOT_VALIDATE_WELD", "", "expected 1 (weld idle turrets) or 0, found '" + v + "'");
+    c.lock_idle_turret = v == "1";
+  }
   // A number from the environment, or a ConfigError naming the variable.
   const auto number = [](const char* name, const char* text, double lo, double hi, const char* range) {
     char* end = nullptr;

@@ -89,6 +89,7 @@ TEST(ToolsCli, UnusableStudyKnobsAreRefusedByName) {
       {"SBOT_VALIDATE_CONTACT_CFM=-1", "$SBOT_VALIDATE_CONTACT_CFM: expected a number in [0, 1], found '-1'"},
       {"SBOT_VALIDATE_CONTACT_ERP=x", "$SBOT_VALIDATE_CONTACT_ERP: expected a number in [0.01, 1], found 'x'"},
       {"SBOT_VALIDATE_TRACK_MU=nan", "$SBOT_VALIDATE_TRACK_MU: expected a number in [0, 100], found 'nan'"},
+      {"SBOT_VALIDATE_WELD=yes", "$SBOT_VALIDATE_WELD: expected 1 (weld idle turrets) or 0, found 'yes'"},
   };
   for (const std::string tool : {"sbot_validate", "two_sbots"}) {
     const std::string bin = std::string(SWARMBOT3D_BIN_DIR) + "/" + tool;
@@ -109,6 +110,18 @@ TEST(ToolsCli, UnusableStudyKnobsAreRefusedByName) {
                                           "/sbot_validate --trial step detailed 0.010");
   EXPECT_EQ(o.status, 0) << o.output;
   EXPECT_NE(o.output.find("step detailed 0.01: pass"), std::string::npos) << o.output;
+}
+
+// The weld knob is a switch: 0 is the default (it used to weld whenever the variable was set), 1
+// welds. Medium on the 0.7 rad ramp is a trial the weld changes (src/validation/README.md, "Turret weld").
+TEST(ToolsCli, TheWeldKnobZeroIsTheDefaultAndOneWelds) {
+  const std::string trial = std::string(SWARMBOT3D_BIN_DIR) + "/sbot_validate --trial uphill medium 0.7";
+  const Outcome unset = sbot_test::runProcess("env -u SBOT_VALIDATE_WELD " + trial);
+  const Outcome zero = sbot_test::runProcess("env SBOT_VALIDATE_WELD=0 " + trial);
+  const Outcome one = sbot_test::runProcess("env SBOT_VALIDATE_WELD=1 " + trial);
+  ASSERT_EQ(unset.status, 0) << unset.output;
+  EXPECT_EQ(zero.output, unset.output);
+  EXPECT_NE(one.output, unset.output) << "welding idle turrets changes nothing in this trial any more: pick another";
 }
 
 // --index picks the cell's trial, i.e. its start perturbation: trial 1 starts elsewhere than trial 0
