@@ -16,7 +16,8 @@ per robot namespace ROBOT (--robot, default sbot_0), with every topic overridabl
   light      /ROBOT/light        sbot_msgs/LightArray -> light0..light7
 
 Time stamps come from message headers when present (bag time otherwise) and are relative to the
-first message of the run. Topics that are absent are simply not measured. The start pose is the
+earliest stamp of the run (not the first message read: a tracker whose header stamps lead the
+commands would otherwise get negative times). Topics that are absent are simply not measured. The start pose is the
 first tracker pose. The world (obstacles, lamps) is copied from --world (a YAML file with the
 dataset's `world:` mapping) and the model level from --level. With --append, runs are added to an
 existing dataset. Message classes are taken from the bag itself, so the workspace need not be sourced.
@@ -60,20 +61,16 @@ def tracker_pose(msg):
 
 
 def read_run(bag_path, topics):
-    """Rows {t: {column: value}} of one bag."""
-    rows = {}
-    first_pose = None
-    t0 = None
+    """Rows {t: {column: value}} of one bag, t from the run's earliest stamp."""
+    stamped = {}  # absolute stamp -> {column: value}
+    first_pose = None  # (stamp, pose) of the earliest tracker message
     wanted = [t for t in topics.values() if t]
     with rosbag.Bag(bag_path) as bag:
         present = set(bag.get_type_and_topic_info().topics.keys())
         missing = [k for k, t in topics.items() if t and t not in present]
         for topic, msg, bt in bag.read_messages(topics=wanted):
             t = stamp_of(msg, bt)
-            if t0 is None:
-                t0 = t
-            key = round(t - t0, 6)
-            row = rows.setdefault(key, {})
+            row = stamped.setdefault(t, {})
             if topic == topics["commands"]:
                 row["cmd_left"], row["cmd_right"] = msg.left, msg.right
             elif topic == topics["tracker"]:
@@ -81,8 +78,8 @@ def read_run(bag_path, topics):
                 if pose is None:
                     raise SystemExit("%s: tracker topic %s has unsupported type %s" % (bag_path, topic, msg._type))
                 row["x"], row["y"], row["yaw"] = pose
-                if first_pose is None:
-                    first_pose = pose
+                if first_pose is None or t < first_pose[0]:
+                    first_pose = (t, pose)
             elif topic == topics["tracks"]:
                 row["speed_left"], row["speed_right"] = msg.measured_left, msg.measured_right
                 row["torque_left"], row["torque_right"] = msg.torque_left, msg.torque_right
@@ -97,7 +94,11 @@ def read_run(bag_path, topics):
             elif topic == topics["light"]:
                 for k, v in enumerate(msg.readings):
                     row["light%d" % k] = v
-    return rows, first_pose, missing
+    rows = {}
+    t0 = min(stamped) if stamped else 0.0
+    for t in sorted(stamped):
+        rows.setdefault(round(t - t0, 6), {}).update(stamped[t])
+    return rows, (first_pose[1] if first_pose else None), missing
 
 
 ORDER = ["cmd_left", "cmd_right", "x", "y", "yaw", "speed_left", "speed_right", "torque_left", "torque_right",

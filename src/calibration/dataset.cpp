@@ -16,7 +16,9 @@
 #include "sbot_sim/core/output_files.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/scenario.h"
-#include "sbot_sim/core/world.h"  // positionProblem
+#include "sbot_sim/core/world.h"  // positionProblem, kMaxCoordinate
+
+#include "calibration/sensor_bridge.h"  // SensorBridge::supports
 
 namespace sbot::calib {
 namespace {
@@ -91,12 +93,39 @@ std::string defaultGroup(const std::string& name) {
   return u == std::string::npos ? name : name.substr(0, u);
 }
 
+std::string fmtNumber(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
+
+/// Why a measured value cannot be a reading of its channel ("" if it can): the sensors' documented
+/// ranges (docs/calibration.md), and for the rest bounds no s-bot reaches, so that a unit mistake or
+/// a corrupt cell is named instead of dominating every error figure.
+std::string channelRangeProblem(const std::string& channel, double v) {
+  const std::string g = NoiseModel::group(channel);
+  double lo = 0, hi = 0;
+  std::string unit;
+  if (g == "ir") hi = 8191;
+  else if (g == "ground") hi = 255;
+  else if (g == "light") hi = 700;
+  else if (g == "position") lo = -kMaxCoordinate, hi = kMaxCoordinate, unit = " m";
+  else if (g == "yaw" || g == "tilt") lo = -1000, hi = 1000, unit = " rad";  // unwrapped angles may run on
+  else if (g == "speed" || g == "torque") lo = -1000, hi = 1000, unit = " API units";
+  else return "";
+  if (v >= lo && v <= hi) return "";
+  return "value " + fmtNumber(v) + " outside the range of " + channel + " [" + fmtNumber(lo) + ", " + fmtNumber(hi) +
+         "]" + unit;
+}
+
 bool parseNumber(const std::string& cell, double& out) {
   if (cell.empty()) return false;
   const char* b = cell.c_str();
   char* e = nullptr;
   errno = 0;
   out = std::strtod(b, &e);
+  // strtod also reads hexadecimal ("0x10" = 16), which no measurement file means.
+  if (cell.find_first_of("xX") != std::string::npos) return false;
   return e != b && *e == '\0';
 }
 
@@ -226,7 +255,9 @@ bool isKnownColumn(const std::string& c) {
 }
 
 void parseRunCsv(const std::string& text, const std::string& file, Run& run) {
-  std::istringstream in(text);
+  // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first column's name.
+  const bool bom = text.rfind("\xEF\xBB\xBF", 0) == 0;
+  std::istringstream in(bom ? text.substr(3) : text);
   std::string raw;
   int line_no = 0;
   std::vector<std::string> header;
@@ -284,6 +315,9 @@ void parseRunCsv(const std::string& text, const std::string& file, Run& run) {
     }
     if (!drive && (c == "x" || c == "y" || c == "yaw" || c == "z")) continue;
     if (drive && c == "z") throw DatasetError(file, header_line, i + 1, c, "column z is only allowed in place runs");
+    if (!drive && !SensorBridge::supports(NoiseModel::group(c)))
+      throw DatasetError(file, header_line, i + 1, c,
+                         "a place run measures sensors only (ir*, ground*, light*): a robot set down has no " + c);
     measured.push_back(c);
   }
   if (measured.empty())
@@ -293,6 +327,8 @@ void parseRunCsv(const std::string& text, const std::string& file, Run& run) {
 
   double last_t = -std::numeric_limits<double>::infinity();
   int last_t_line = 0;
+  double max_gap = 0;  // [s] the longest time between two consecutive rows, and where it ends
+  int max_gap_line = 0;
   int row = 0;
   while (std::getline(in, raw)) {
     ++line_no;
@@ -322,6 +358,10 @@ void parseRunCsv(const std::string& text, const std::string& file, Run& run) {
         throw DatasetError(file, line_no, col.at("t") + 1, "t",
                            "time is not increasing (" + std::to_string(t) + " after " + std::to_string(last_t) +
                                " on line " + std::to_string(last_t_line) + ")");
+      if (row > 0 && t - last_t > max_gap) {
+        max_gap = t - last_t;
+        max_gap_line = line_no;
+      }
       last_t = t;
       last_t_line = line_no;
     }
@@ -365,6 +405,12 @@ void parseRunCsv(const std::string& text, const std::string& file, Run& run) {
     for (const auto& c : measured) {
       double v;
       if (!value(c, v)) continue;
+      if (drive && t < 0)
+        throw DatasetError(file, line_no, col.at(c) + 1, c,
+                           "measured at t = " + fmtNumber(t) +
+                               " s, before the replay's start at t = 0 (shift the run's times so that it starts at 0)");
+      const std::string range = channelRangeProblem(c, v);
+      if (!range.empty()) throw DatasetError(file, line_no, col.at(c) + 1, c, range);
       Series& s = run.channels[c];
       s.t.push_back(drive ? t : row);
       s.v.push_back(v);
@@ -375,11 +421,23 @@ void parseRunCsv(const std::string& text, const std::string& file, Run& run) {
   }
   if (row == 0) throw DatasetError(file, header_line, 0, "", "no data rows");
   if (drive && run.cmd_t.empty()) throw DatasetError(file, header_line, 0, "cmd_left", "no command in any row");
+  if (drive && run.t_end > kMaxRunDuration)
+    throw DatasetError(file, last_t_line, col.at("t") + 1, "t",
+                       "the run ends at t = " + fmtNumber(run.t_end) + " s; runs longer than " +
+                           fmtNumber(kMaxRunDuration) + " s are refused (the replay simulates every step): are the times in seconds?");
+  if (drive && max_gap > kMaxRowGap)
+    throw DatasetError(file, max_gap_line, col.at("t") + 1, "t",
+                       "a gap of " + fmtNumber(max_gap) + " s since the previous row; gaps over " + fmtNumber(kMaxRowGap) +
+                           " s are refused (the replay would simulate them blind): are the times in seconds?");
+  if (run.sampleCount() == 0)
+    throw DatasetError(file, header_line, 0, "", "no measured value in any row: nothing to compare the model with");
   for (const auto& c : measured)
     if (!run.channels.count(c)) run.channels[c] = Series{};  // declared but never measured: kept empty
 }
 
-Dataset loadDataset(const std::string& path_in) {
+namespace {
+
+Dataset loadDatasetFields(const std::string& path_in) {
   std::string yaml_path = path_in;
   if (isDirectory(path_in)) yaml_path = path_in + (path_in.back() == '/' ? "" : "/") + "dataset.yaml";
   Dataset ds;
@@ -411,7 +469,10 @@ Dataset loadDataset(const std::string& path_in) {
   if (root["align_initial_pose"]) ds.align_initial_pose = root["align_initial_pose"].as<bool>();
   if (root["align_segment"]) {
     ds.align_segment = number(root["align_segment"], f, "align_segment");
-    if (ds.align_segment < 0) fail(f, root["align_segment"], "align_segment", "must be >= 0 (0 = align the start only)");
+    if (!(ds.align_segment == 0 || ds.align_segment >= kMinAlignSegment))
+      fail(f, root["align_segment"], "align_segment",
+           "must be 0 (align the start only) or at least " + fmtNumber(kMinAlignSegment) +
+               " s: shorter segments re-anchor the model so often that they hide its error");
   }
 
   std::set<std::string> surfaces = knownSurfaces();
@@ -434,9 +495,10 @@ Dataset loadDataset(const std::string& path_in) {
     try {
       ds.world = parseScenario(YAML::Dump(scenario), f).world;
     } catch (const ConfigError& e) {
-      const std::string field = e.field();
-      YAML::Node where = w;
-      throw DatasetError(f, where.Mark().line + 1, where.Mark().column + 1, "", e.what());
+      // The scenario parser's message starts with the file we gave it: keep one copy of it.
+      std::string what = e.what();
+      if (what.rfind(f + ": ", 0) == 0) what = what.substr(f.size() + 2);
+      throw DatasetError(f, w.Mark().line + 1, w.Mark().column + 1, "", what);
     }
     ds.world_sets_step = static_cast<bool>(w["step"]);
     ds.world_sets_gravity = static_cast<bool>(w["gravity"]);
@@ -520,7 +582,17 @@ Dataset loadDataset(const std::string& path_in) {
     Run run;
     if (!r["file"]) fail(f, r, field + ".file", "missing");
     run.file = r["file"].as<std::string>();
-    run.name = r["name"] ? r["name"].as<std::string>() : run.file.substr(0, run.file.find_last_of('.'));
+    if (run.file.empty()) fail(f, r["file"], field + ".file", "empty file name");
+    if (r["name"]) {
+      run.name = r["name"].as<std::string>();
+    } else {  // the file's name without its folders and extension
+      const std::string base = run.file.substr(run.file.find_last_of('/') + 1);
+      run.name = base.substr(0, base.find_last_of('.'));
+    }
+    // The name becomes a file name in the reports (data/<version>/<name>.csv).
+    if (run.name.empty() || run.name == "." || run.name == ".." || run.name.find_first_of("/\\") != std::string::npos)
+      fail(f, r["name"] ? r["name"] : r["file"], field + ".name",
+           "run name '" + run.name + "' must be a plain file name (not empty, no '/' or '\\')");
     if (!names.insert(run.name).second) fail(f, r["name"] ? r["name"] : r, field + ".name", "duplicate run name '" + run.name + "'");
     const std::string kind = r["kind"] ? r["kind"].as<std::string>() : "drive";
     if (kind == "drive") run.kind = RunKind::Drive;
@@ -529,9 +601,11 @@ Dataset loadDataset(const std::string& path_in) {
     if (const YAML::Node p = r["initial_pose"]) {
       if (!p.IsMap()) fail(f, p, field + ".initial_pose", "expected {x, y, yaw}");
       allowOnly(p, f, field + ".initial_pose", {"x", "y", "yaw"});
-      run.initial_pose.x = p["x"] ? number(p["x"], f, field + ".initial_pose.x") : 0.0;
-      run.initial_pose.y = p["y"] ? number(p["y"], f, field + ".initial_pose.y") : 0.0;
-      run.initial_pose.yaw = p["yaw"] ? number(p["yaw"], f, field + ".initial_pose.yaw") : 0.0;
+      for (const char* k : {"x", "y", "yaw"})
+        if (!p[k]) fail(f, p, field + ".initial_pose." + k, "missing (a start pose gives x, y and yaw)");
+      run.initial_pose.x = number(p["x"], f, field + ".initial_pose.x");
+      run.initial_pose.y = number(p["y"], f, field + ".initial_pose.y");
+      run.initial_pose.yaw = number(p["yaw"], f, field + ".initial_pose.yaw");
     } else if (run.kind == RunKind::Drive) {
       fail(f, r, field + ".initial_pose", "missing (a drive run starts from a known pose)");
     }
@@ -545,6 +619,17 @@ Dataset loadDataset(const std::string& path_in) {
     ds.runs.push_back(std::move(run));
   }
   return ds;
+}
+
+}  // namespace
+
+Dataset loadDataset(const std::string& path) {
+  try {
+    return loadDatasetFields(path);
+  } catch (const YAML::Exception& e) {  // a value of the wrong type (e.g. a list where a name belongs)
+    const std::string yaml = isDirectory(path) ? path + (path.back() == '/' ? "" : "/") + "dataset.yaml" : path;
+    throw DatasetError(yaml, e.mark.line + 1, e.mark.column + 1, "", "value of the wrong type: " + e.msg);
+  }
 }
 
 // ---- writing -------------------------------------------------------------------------------------

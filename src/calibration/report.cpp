@@ -8,6 +8,14 @@
 #include <iomanip>
 #include <sstream>
 
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>  // environ
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
 #include "sbot_sim/core/output_files.h"
 
 namespace sbot::calib {
@@ -50,6 +58,24 @@ std::string unitOf(const std::string& c) {
   if (g == "position") return "m";
   if (g == "yaw" || g == "tilt") return "rad";
   return "units";
+}
+
+/// Runs `program` with `args` (no shell: the arguments reach it as they are, whatever characters
+/// a path holds) and waits. Returns "" on success, else what went wrong.
+std::string runScript(const std::string& program, const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  argv.push_back(const_cast<char*>(program.c_str()));
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (const int rc = posix_spawn(&pid, program.c_str(), nullptr, nullptr, argv.data(), environ); rc != 0)
+    return "cannot start " + program + ": " + std::strerror(rc);
+  int status = 0;
+  if (waitpid(pid, &status, 0) < 0) return "waiting for " + program + ": " + std::strerror(errno);
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return "";
+  std::string cmd = program;
+  for (const auto& a : args) cmd += " '" + a + "'";
+  return cmd + (WIFEXITED(status) ? " exited with status " + std::to_string(WEXITSTATUS(status)) : " was killed");
 }
 
 }  // namespace
@@ -212,6 +238,15 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
     j.commit();
   }
 
+  // The plots, drawn by plot_report.py from summary.json and the CSV files above. A reused output
+  // folder must not show an earlier dataset's plots.
+  for (const char* png : {"heatmap.png", "trajectories.png", "residual_time.png", "residual_features.png", "parity.png",
+                          "sensor_features.png", "before_after.png", "waterfall.png"})
+    std::remove((opt.out_dir + "/plots/" + png).c_str());
+  const std::string plot_problem =
+      opt.plots ? runScript("/usr/bin/python3", {scriptDirectory() + "/plot_report.py", opt.out_dir}) : "";
+  const bool drawn = opt.plots && plot_problem.empty();
+
   // The Markdown report.
   OutputFile md(opt.out_dir + "/report.md");
   md << "# Model vs measurements: " << ds.name << "\n\n";
@@ -246,7 +281,7 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
     md << "\n";
   }
   md << "\n";
-  if (sums.size() > 1) {
+  if (sums.size() > 1 && drawn) {
     md << "### Before / after\n\n![before and after](plots/before_after.png)\n\n"
        << "### Waterfall (effects added one by one)\n\n![waterfall](plots/waterfall.png)\n\n";
   }
@@ -309,24 +344,22 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
     md << "\n";
   }
 
-  md << "## Where the model fails\n\n"
-     << "### Error by run and time window\n\n![heat map](plots/heatmap.png)\n\n"
-     << "### Trajectories (measured vs simulated, open loop from the start pose)\n\n![trajectories](plots/trajectories.png)\n\n"
-     << "### Residual against time (turns shaded, contacts marked)\n\n![residual vs time](plots/residual_time.png)\n\n"
-     << "### Residual against inputs and features\n\n![residual vs features](plots/residual_features.png)\n\n"
-     << "### Parity (measured against simulated)\n\n![parity](plots/parity.png)\n\n";
-  if (sensors)
-    md << "### Sensors: residual against distance, incidence angle and surface\n\n![sensor residuals](plots/sensor_features.png)\n\n";
+  // The plots of the failures.
+  std::vector<std::pair<std::string, std::string>> plots = {
+      {"Error by run and time window", "heatmap.png"},
+      {"Trajectories (measured vs simulated, open loop from the start pose)", "trajectories.png"},
+      {"Residual against time (turns shaded, contacts marked)", "residual_time.png"},
+      {"Residual against inputs and features", "residual_features.png"},
+      {"Parity (measured against simulated)", "parity.png"}};
+  if (sensors) plots.push_back({"Sensors: residual against distance, incidence angle and surface", "sensor_features.png"});
+  md << "## Where the model fails\n\n";
+  if (!opt.plots) md << "Plots not drawn (`--no-plots`): `plot_report.py " << opt.out_dir << "` draws them.\n\n";
+  else if (!drawn) md << "> plots could not be drawn: " << plot_problem << "\n\n";
+  else
+    for (const auto& [title, file] : plots) md << "### " << title << "\n\n![" << title << "](plots/" << file << ")\n\n";
   md.commit();
-
-  if (opt.plots) {
-    const std::string cmd = "/usr/bin/python3 '" + scriptDirectory() + "/plot_report.py' '" + opt.out_dir + "'";
-    if (std::system(cmd.c_str()) != 0) {
-      OutputFile app(opt.out_dir + "/report.md", std::ios::app);
-      app << "\n> plots could not be drawn (" << cmd << " failed)\n";
-      app.commit();
-    }
-  }
+  if (!plot_problem.empty())
+    std::fprintf(stderr, "sbot_calibrate: warning: plots could not be drawn: %s\n", plot_problem.c_str());
   return sums;
 }
 

@@ -64,7 +64,7 @@ class BagImporterTest(unittest.TestCase):
     def tearDownClass(cls):
         shutil.rmtree(cls.tmp, ignore_errors=True)
 
-    def write_bag(self, run, path, with_commands=True):
+    def write_bag(self, run, path, with_commands=True, tracker_lead=0.0):
         rows = read_csv(os.path.join(self.tmp, "src", run + ".csv"))
         base = 1000.0
         with rosbag.Bag(path, "w") as bag:
@@ -75,7 +75,7 @@ class BagImporterTest(unittest.TestCase):
                                                                right=int(float(r["cmd_right"]))), t)
                 if r["x"] != "":
                     m = PoseStamped()
-                    m.header.stamp = t
+                    m.header.stamp = rospy.Time.from_sec(base + float(r["t"]) - tracker_lead)
                     m.pose.position.x, m.pose.position.y = float(r["x"]), float(r["y"])
                     yaw = float(r["yaw"])
                     m.pose.orientation.z, m.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
@@ -120,6 +120,23 @@ class BagImporterTest(unittest.TestCase):
                               "--jobs", "1"], capture_output=True, text=True)
         self.assertEqual(res.returncode, 0, res.stderr)
         self.assertIn("nominal", res.stdout)
+
+    def test_times_start_at_the_earliest_stamp(self):
+        # A tracker on another clock stamps its poses 0.5 s ahead of the commands, which are read first:
+        # times relative to the first message read were negative and crashed the replay.
+        path = os.path.join(self.tmp, "lead.bag")
+        original = self.write_bag("straight_20", path, tracker_lead=0.5)
+        first_pose_t = next(float(r["t"]) for r in original if r["x"] != "")
+        out = os.path.join(self.tmp, "lead")
+        self.assertEqual(bag_to_dataset.main([out, path, "--tracker-topic", "/tracker/sbot_0", "--level", "simple"]), 0)
+        rows = read_csv(os.path.join(out, "lead.csv"))
+        self.assertAlmostEqual(float(rows[0]["t"]), 0.0, places=6)
+        self.assertNotEqual(rows[0]["x"], "", "the earliest row is the tracker's")
+        first_cmd = next(float(r["t"]) for r in rows if r["cmd_left"] != "")
+        self.assertAlmostEqual(first_cmd, 0.5 - first_pose_t, places=5)
+        res = subprocess.run([self.tool, "compare", out, "--no-plots", "--out", os.path.join(self.tmp, "lead_report"),
+                              "--jobs", "1"], capture_output=True, text=True)
+        self.assertEqual(res.returncode, 0, res.stderr)
 
     def test_bag_without_commands_is_refused(self):
         path = os.path.join(self.tmp, "nocmd.bag")

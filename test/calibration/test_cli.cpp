@@ -3,7 +3,11 @@
 // model), and so are bad values of the ones it does take.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "../common/run_process.h"
@@ -53,6 +57,25 @@ TEST(Cli, AnOutputPlaceThatCannotBeWrittenIsRefusedBeforeTheWork) {
           "--out: cannot create directory '" + dir + "plain': '" + dir + "plain' exists and is not a directory");
   refused(run("diagnose " + kExample + " --write-effects " + dir), "--write-effects: cannot write '" + dir + "': it is a directory");
   refused(run("generate --out " + dir + "plain"), "--out: cannot create directory '" + dir + "plain'");
+}
+
+// The plot script is started without a shell: an output folder with a quote in its name used to
+// end the quoting and run the rest as a command. --no-plots links no plot that is not drawn.
+TEST(Cli, TheOutputFolderIsNotShellTextAndUndrawnPlotsAreNotLinked) {
+  const std::string base = testing::TempDir() + "cli_quote/";
+  std::system(("rm -rf '" + base + "' && mkdir -p '" + base + "'").c_str());
+  const std::string out = base + "it's;touch " + base + "INJECTED;'";
+  const Outcome o = run("compare " + kExample + " --jobs 1 --quiet --out \"" + out + "\"");
+  EXPECT_EQ(o.status, 0) << o.output;
+  struct stat st;
+  EXPECT_NE(::stat((base + "INJECTED").c_str(), &st), 0) << "the folder name ran as a shell command";
+  EXPECT_EQ(::stat((out + "/plots/parity.png").c_str(), &st), 0) << "plot_report.py got the folder as it is: " << o.output;
+  const Outcome np = run("compare " + kExample + " --jobs 1 --quiet --no-plots --out \"" + out + "\"");
+  EXPECT_EQ(np.status, 0) << np.output;
+  std::ifstream md(out + "/report.md");
+  const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text.find(".png"), std::string::npos) << "links a plot --no-plots did not draw";
+  EXPECT_NE(::stat((out + "/plots/parity.png").c_str(), &st), 0) << "the earlier run's plot is still there";
 }
 
 TEST(Cli, TheOptionsItTakesAreAccepted) {

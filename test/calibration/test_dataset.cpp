@@ -211,5 +211,65 @@ TEST(Dataset, BadYaml) {
   EXPECT_THROW(loadDataset("/nonexistent/dataset"), DatasetError);
 }
 
+// Input that used to crash a replay, run it for hours or turn into wrong numbers (an outside
+// probe of 2026-11-28): each is refused naming the file, line and column.
+TEST(Dataset, ValuesNoReplayCanUseAreRefusedByPlace) {
+  const std::string head = "t,cmd_left,cmd_right,x,ir0\n0,1,1,0,\n";
+  struct Case {
+    const char* name;
+    std::string csv;
+    int line;
+    const char* column;
+    const char* says;
+  };
+  const Case cases[] = {
+      // a tracker stamp before the first command (a bag whose clocks differ): was a heap overwrite
+      {"negative_t", "t,cmd_left,cmd_right,x\n-20,,,0\n0,1,1,0\n", 2, "x", "before the replay's start at t = 0"},
+      {"epoch_t", "t,cmd_left,cmd_right,x\n1700000000,1,1,0\n1700000001,,,0\n", 3, "t", "are the times in seconds?"},
+      {"gap", head + "0.1,,,0,\n100,,,0,\n", 4, "t", "a gap of 99.9 s"},
+      {"hex", head + "0.1,,,0x10,\n", 3, "x", "not a number: '0x10'"},
+      {"ir_range", head + "0.1,,,0,99999\n", 3, "ir0", "outside the range of ir0 [0, 8191]"},
+      {"position_range", head + "0.1,,,1e300,\n", 3, "x", "outside the range of x"},
+      {"no_sample", "t,cmd_left,cmd_right,x\n0,1,1,\n1,2,2,\n", 1, "", "no measured value in any row"},
+  };
+  for (const Case& c : cases) {
+    const DatasetError e = errorOf(makeDataset(c.name, c.csv));
+    EXPECT_EQ(e.line(), c.line) << c.name << ": " << e.what();
+    EXPECT_EQ(e.columnName(), c.column) << c.name << ": " << e.what();
+    EXPECT_NE(std::string(e.what()).find(c.says), std::string::npos) << c.name << ": " << e.what();
+  }
+  // A byte-order mark (spreadsheet export) is not part of the first column's name.
+  EXPECT_NO_THROW(loadDataset(makeDataset("bom", "\xEF\xBB\xBFt,cmd_left,cmd_right,x\n0,1,1,0\n")));
+}
+
+TEST(Dataset, RunNamesStartPosesAndSegmentsAreChecked) {
+  const std::string csv = "t,cmd_left,cmd_right,x\n0,1,1,0\n";
+  const auto withRun = [](const std::string& run) {
+    std::string yaml = kYaml;
+    const std::size_t at = yaml.find("  - {name: straight");
+    return yaml.substr(0, at) + run;
+  };
+  // The name becomes a file name under the report's folder: no path may escape it.
+  DatasetError e = errorOf(makeDataset(
+      "name_path", csv, withRun("  - {name: ../../x, file: straight.csv, initial_pose: {x: 0, y: 0, yaw: 0}}\n")));
+  EXPECT_NE(std::string(e.what()).find("must be a plain file name"), std::string::npos) << e.what();
+  // Without a name, a run in a subfolder is named after its file alone.
+  const std::string sub = makeDataset("subfolder", csv, withRun("  - {file: day1/straight.csv, initial_pose: {x: 0, y: 0, yaw: 0}}\n"));
+  ::mkdir((sub + "/day1").c_str(), 0755);
+  write(sub + "/day1/straight.csv", csv);
+  EXPECT_EQ(loadDataset(sub).runs.at(0).name, "straight");
+  // A start pose without its yaw used to start at yaw 0.
+  e = errorOf(makeDataset("pose", csv, withRun("  - {name: s, file: straight.csv, initial_pose: {x: 0, y: 0}}\n")));
+  EXPECT_NE(std::string(e.what()).find("runs[0].initial_pose.yaw"), std::string::npos) << e.what();
+  // A value of the wrong type names the file and line (was yaml-cpp's bare "bad conversion").
+  e = errorOf(makeDataset("type", csv, withRun("  - {name: s, group: [a, b], file: straight.csv, initial_pose: {x: 0, y: 0, yaw: 0}}\n")));
+  EXPECT_NE(e.file().find("dataset.yaml"), std::string::npos) << e.what();
+  EXPECT_EQ(e.line(), 8) << e.what();
+  // Re-anchoring every 50 ms hid a 10 % speed error.
+  e = errorOf(makeDataset("segment", csv, "align_segment: 0.05\n" + std::string(kYaml)));
+  EXPECT_NE(std::string(e.what()).find("at least 1 s"), std::string::npos) << e.what();
+  EXPECT_NO_THROW(loadDataset(makeDataset("segment_ok", csv, "align_segment: 0\n" + std::string(kYaml))));
+}
+
 }  // namespace
 }  // namespace sbot::calib

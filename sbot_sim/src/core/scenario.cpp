@@ -203,7 +203,9 @@ void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
   w.solver = f.text("solver", w.solver);
   if (w.solver != "quickstep" && w.solver != "exact")
     throw ConfigError(file, f.path("solver"), "expected 'quickstep' or 'exact', found '" + w.solver + "'");
-  w.step = f.positive("step", w.step);
+  // [s] 0.1 ms to 0.5 s: below, a run of seconds takes millions of steps (a step given in the wrong
+  // unit); above, no level's contacts hold (the Fast level's 100 ms is the largest the seed uses).
+  w.step = f.within("step", w.step, 1e-4, 0.5);
   w.gravity = f.number("gravity", w.gravity);
   if (w.gravity < 0) throw ConfigError(file, f.path("gravity"), "must be >= 0 (its magnitude: gravity points along -z)");
   w.solver_iterations = static_cast<int>(f.integer("solver_iterations", w.solver_iterations, 1, 100000));
