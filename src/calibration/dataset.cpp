@@ -17,6 +17,7 @@
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/scenario.h"
 #include "sbot_sim/core/world.h"  // positionProblem, kMaxCoordinate
+#include "sbot_sim/core/yaml_checks.h"
 
 #include "calibration/sensor_bridge.h"  // SensorBridge::supports
 
@@ -452,6 +453,7 @@ Dataset loadDatasetFields(const std::string& path_in) {
   } catch (const YAML::Exception& e) {
     throw DatasetError(f, e.mark.line + 1, e.mark.column + 1, "", "not valid YAML: " + e.msg);
   }
+  if (const std::string dup = duplicateKeyProblem(root); !dup.empty()) throw DatasetError(f, 0, 0, "", dup);
   if (!root.IsMap()) throw DatasetError(f, 1, 1, "", "expected a mapping at the top level");
   allowOnly(root, f, "", {"format", "name", "description", "robot", "world", "noise", "runs", "surfaces",
                           "align_initial_pose", "align_segment", "generator"});

@@ -7,18 +7,23 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "sbot_sim/core/yaml_checks.h"
+
 namespace sbot {
 namespace validation {
 
 /// The parsed file; throws std::runtime_error("<what> <path>: cannot be read" / ": not YAML (...)").
 inline YAML::Node loadYamlFile(const std::string& what, const std::string& path) {
+  YAML::Node root;
   try {
-    return YAML::LoadFile(path);
+    root = YAML::LoadFile(path);
   } catch (const YAML::BadFile&) {
     throw std::runtime_error(what + " " + path + ": cannot be read");
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(what + " " + path + ": not YAML (" + e.msg + ", line " + std::to_string(e.mark.line + 1) + ")");
   }
+  if (const std::string dup = duplicateKeyProblem(root); !dup.empty()) throw std::runtime_error(what + " " + path + ": " + dup);
+  return root;
 }
 
 }  // namespace validation

@@ -9,6 +9,7 @@
 #include <urdf_parser/urdf_parser.h>
 #include <yaml-cpp/yaml.h>
 
+#include "sbot_sim/core/yaml_checks.h"
 #include "sbot_sim/core/errors.h"
 
 #ifndef SBOT_DESCRIPTION_SOURCE_DIR
@@ -184,6 +185,7 @@ void parseSidecar(RobotDescription& d) {
   } catch (const YAML::Exception& e) {
     throw ConfigError(file, "", std::string("not valid YAML: ") + e.what());
   }
+  if (const std::string dup = duplicateKeyProblem(root); !dup.empty()) throw ConfigError(file, "", dup);
   d.level = get<std::string>(root, "level", "", file, "");
   if (d.level.empty()) throw ConfigError(file, "level", "missing");
   d.recommended_step = get<double>(root, "recommended_step", 0.01, file, "");

@@ -9,6 +9,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "sbot_sim/core/yaml_checks.h"
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/world.h"  // robotNameProblem
@@ -264,6 +265,7 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
   } catch (const YAML::Exception& e) {
     throw ConfigError(file, "", "not valid YAML (line " + std::to_string(e.mark.line + 1) + "): " + e.msg);
   }
+  if (const std::string dup = duplicateKeyProblem(root); !dup.empty()) throw ConfigError(file, "", dup);
   if (!root.IsMap()) throw ConfigError(file, "", "expected a mapping at the top level");
   Fields f(root, "", file);
   f.allowOnly({"seed", "duration", "world", "robots", "swarm", "links", "name", "description", "effects"});

@@ -80,6 +80,10 @@ TEST(Scenario, RefusesValuesThatWouldMisbehaveLater) {
   refused("world: {terrain: {type: rough, resolution: 100000}}", "'world.terrain.resolution': must be a whole number in [8, 4096]");
   refused("world: {terrain: {type: rough, seed: 0.5}}", "'world.terrain.seed': must be a whole number");
   refused("world: {gravity: -9.81}", "'world.gravity': must be >= 0");
+  refused("world: {step: 1e-7}", "'world.step': must be in [0.0001, 0.5], found 1e-07");
+  // yaml-cpp keeps both copies of a repeated key and reads the first: the second was lost silently.
+  refused("seed: 1\nworld:\n  step: 0.01\n  step: 0.1\n", "key 'step' appears twice in one mapping (lines 3 and 4)");
+  refused("robots: [{name: a, x: 0, x: 1}]", "key 'x' appears twice");
   refused("world: {contact: {erp: 5}}", "'world.contact.erp': must be in [0, 1], found 5");
   refused("world: {contact: {cfm: -1}}", "'world.contact.cfm': must be >= 0");
   refused("world: {contact: {bounce: 2}}", "'world.contact.bounce': must be in [0, 1]");

@@ -9,6 +9,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "sbot_sim/core/yaml_checks.h"
 #include "sbot_sim/core/effects/effect_registry.h"
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/output_files.h"
@@ -50,6 +51,7 @@ std::vector<EffectConfig> parseEffectsConfig(const std::string& yaml_text, const
   } catch (const YAML::Exception& e) {
     throw ConfigError(src, "", "not valid YAML (line " + std::to_string(e.mark.line + 1) + "): " + e.msg);
   }
+  if (const std::string dup = duplicateKeyProblem(root); !dup.empty()) throw ConfigError(src, "", dup);
   std::vector<EffectConfig> out;
   if (!root || root.IsNull()) return out;  // an empty file = no effects
   if (!root.IsMap()) throw ConfigError(src, "", "expected a mapping with an 'effects' list");
