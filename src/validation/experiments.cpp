@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -118,12 +119,15 @@ BoxObstacle ramp(const Vec3& foot, double angle, double length, const std::strin
   return b;
 }
 
-BoxObstacle block(double x0, double x1, double top, const std::string& name) {
+/// Adds a block standing on the floor over [x0, x1], `top` high; none if top <= 0 (a 0 mm step is
+/// the floor itself: a block of no height is a degenerate box that stops ODE with an assertion).
+void addBlock(std::vector<BoxObstacle>& boxes, double x0, double x1, double top, const std::string& name) {
+  if (!(top > 0)) return;
   BoxObstacle b;
   b.name = name;
   b.center = Vec3((x0 + x1) / 2, 0, top / 2);
   b.size = Vec3(x1 - x0, 1.0, top);
-  return b;
+  boxes.push_back(b);
 }
 
 /// The front gripper's servos (elevation, jaws) are powered on the real robot and hold their
@@ -217,8 +221,8 @@ TrialWorld gapWorld(const std::string& level, double gap_m, int trial, const Dri
   // comparable conditions" (the seed's Fast passing 6 cm, longer than itself, needs it too).
   const double gap = gap_m * s;
   t.world.terrain.type = TerrainConfig::Type::Composite;
-  t.world.terrain.boxes.push_back(block(-1.0 - gap / 2, -gap / 2, top, "near_side"));
-  t.world.terrain.boxes.push_back(block(gap / 2, 1.0 + gap / 2, top, "far_side"));
+  addBlock(t.world.terrain.boxes, -1.0 - gap / 2, -gap / 2, top, "near_side");
+  addBlock(t.world.terrain.boxes, gap / 2, 1.0 + gap / 2, top, "far_side");
   const double x0 = -gap / 2 - 0.075 * s + j.uniform(-0.005, 0.005) * s;
   t.start = {x0, j.uniform(-0.01, 0.01) * s, j.uniform(-0.05, 0.05)};
   t.units = drive.units;
@@ -279,7 +283,7 @@ TrialWorld stepWorld(const std::string& level, double height_m, bool backward, i
   Jitter j(std::string("step") + (backward ? "b" : "f") + level, height_m, trial);
   TrialWorld t{configFor(d, 2000 + trial, drive)};
   t.world.terrain.type = TerrainConfig::Type::Composite;
-  t.world.terrain.boxes.push_back(block(0.0, 1.0, height_m, "step"));
+  addBlock(t.world.terrain.boxes, 0.0, 1.0, height_m, "step");
   const double x0 = -0.075 * s + j.uniform(-0.005, 0.005) * s;
   const double yaw = (backward ? M_PI : 0.0) + j.uniform(-0.03, 0.03);
   t.start = {x0, j.uniform(-0.01, 0.01) * s, yaw};
@@ -450,7 +454,7 @@ TrialWorld downhillWorld(const std::string& level, double angle_rad, int trial, 
   t.world.terrain.type = TerrainConfig::Type::Composite;
   const double L = downhillRampLength(s);
   const double H = L * std::sin(angle_rad);
-  t.world.terrain.boxes.push_back(block(-1.0, 0.0, H, "plateau"));
+  addBlock(t.world.terrain.boxes, -1.0, 0.0, H, "plateau");
   t.world.terrain.boxes.push_back(ramp(Vec3(0, 0, H), -angle_rad, L + 0.05, "ramp"));
   t.start = {-0.10 * s + j.uniform(-0.01, 0.01) * s, j.uniform(-0.01, 0.01) * s, j.uniform(-0.05, 0.05)};
   t.units = drive.units;
@@ -711,14 +715,42 @@ double lengthScale(const std::string& level) { return level == "fast" ? 0.5 : 1.
 
 // ---- infrastructure -------------------------------------------------------------------------------
 
-std::vector<Outcome> runParallel(int n, int processes, const std::function<Outcome(int)>& fn) {
-  std::vector<Outcome> out(n, Outcome{"error"});
-  if (n <= 0) return out;
-  processes = std::max(1, std::min(processes, n));
+namespace {
+
+// The workers of the round in progress and their result files, for the interrupt handler: a
+// Ctrl-C or SIGTERM of sbot_validate must not leave workers running on, re-parented to init, nor
+// result files in /tmp. Plain arrays: a signal handler may only touch what is async-signal-safe.
+constexpr int kMaxWorkers = 256;
+volatile sig_atomic_t g_worker_count = 0;
+pid_t g_worker_pids[kMaxWorkers];
+char g_worker_files[kMaxWorkers][32];
+
+void stopWorkersAndExit(int sig) {
+  for (int k = 0; k < g_worker_count; ++k) {
+    if (g_worker_pids[k] > 0) kill(g_worker_pids[k], SIGKILL);
+    unlink(g_worker_files[k]);
+  }
+  _exit(128 + sig);
+}
+
+/// One round: `jobs` spread over up to `processes` workers (worker k takes jobs k, k + P, ...).
+/// Fills `out` with what the workers reported; returns the jobs a crashed worker did not report,
+/// in the order it would have run them, one list per crashed worker.
+std::vector<std::vector<int>> runRound(const std::vector<int>& jobs, int processes, const std::function<Outcome(int)>& fn,
+                                       std::vector<Outcome>& out, std::vector<bool>& reported) {
+  const int n = static_cast<int>(jobs.size());
+  processes = std::max(1, std::min({processes, n, kMaxWorkers}));
   std::vector<std::string> files;
   std::vector<pid_t> pids;
+  std::vector<int> slice;  // the worker index k of each started worker
   std::fflush(stdout);
   std::fflush(stderr);
+  struct sigaction stop {}, old_int {}, old_term {};
+  stop.sa_handler = stopWorkersAndExit;
+  sigemptyset(&stop.sa_mask);
+  sigaction(SIGINT, &stop, &old_int);
+  sigaction(SIGTERM, &stop, &old_term);
+  g_worker_count = 0;
   for (int k = 0; k < processes; ++k) {
     char tmpl[] = "/tmp/sbot_validate_XXXXXX";
     const int fd = mkstemp(tmpl);
@@ -734,34 +766,42 @@ std::vector<Outcome> runParallel(int n, int processes, const std::function<Outco
       std::remove(tmpl);
       continue;
     }
-    files.push_back(tmpl);
     if (pid == 0) {
-      std::ofstream f(files.back());
+      signal(SIGINT, SIG_DFL);
+      signal(SIGTERM, SIG_DFL);
+      std::ofstream f(tmpl);
       for (int i = k; i < n; i += processes) {
+        const int job = jobs[i];
         Outcome o{"error"};
         try {
-          o = fn(i);
+          o = fn(job);
         } catch (const std::exception& e) {
-          std::fprintf(stderr, "sbot_validate: job %d: %s\n", i, e.what());
+          std::fprintf(stderr, "sbot_validate: job %d: %s\n", job, e.what());
         }
         std::string label = o.label;
         std::replace(label.begin(), label.end(), '\t', ' ');
-        f << i << '\t' << label << '\t' << o.value << '\t' << o.value2 << '\n';
+        f << job << '\t' << label << '\t' << o.value << '\t' << o.value2 << '\n';
         f.flush();
       }
       f.close();
       std::_Exit(0);
     }
+    std::snprintf(g_worker_files[g_worker_count], sizeof(g_worker_files[0]), "%s", tmpl);
+    g_worker_pids[g_worker_count] = pid;
+    g_worker_count = g_worker_count + 1;
+    files.push_back(tmpl);
     pids.push_back(pid);
+    slice.push_back(k);
   }
-  for (pid_t p : pids) {
+  std::vector<bool> crashed(pids.size(), false);
+  for (std::size_t w = 0; w < pids.size(); ++w) {
     int status = 0;
-    waitpid(p, &status, 0);
-    // A worker that crashed (a signal, not an exception, which it reports itself) leaves its
-    // remaining trials "error" in the report; say so here, where the cause can still be seen.
-    if (WIFSIGNALED(status))
-      std::fprintf(stderr, "sbot_validate: a worker process died of signal %d (%s); its unfinished trials are marked error\n",
-                   WTERMSIG(status), strsignal(WTERMSIG(status)));
+    waitpid(pids[w], &status, 0);
+    if (WIFSIGNALED(status)) {
+      crashed[w] = true;
+      std::fprintf(stderr, "sbot_validate: a worker process died of signal %d (%s)\n", WTERMSIG(status),
+                   strsignal(WTERMSIG(status)));
+    }
   }
   for (const auto& name : files) {
     std::ifstream f(name);
@@ -774,9 +814,47 @@ std::vector<Outcome> runParallel(int n, int processes, const std::function<Outco
       std::getline(ss, v1, '\t');
       std::getline(ss, v2, '\t');
       const int i = std::atoi(idx.c_str());
-      if (i >= 0 && i < n) out[i] = Outcome{label, std::atof(v1.c_str()), std::atof(v2.c_str())};
+      if (i >= 0 && i < static_cast<int>(out.size())) {
+        out[i] = Outcome{label, std::atof(v1.c_str()), std::atof(v2.c_str())};
+        reported[i] = true;
+      }
     }
     std::remove(name.c_str());
+  }
+  g_worker_count = 0;
+  sigaction(SIGINT, &old_int, nullptr);
+  sigaction(SIGTERM, &old_term, nullptr);
+  std::vector<std::vector<int>> unfinished;
+  for (std::size_t w = 0; w < pids.size(); ++w) {
+    if (!crashed[w]) continue;
+    std::vector<int> left;
+    for (int i = slice[w]; i < n; i += processes)
+      if (!reported[jobs[i]]) left.push_back(jobs[i]);
+    unfinished.push_back(left);
+  }
+  return unfinished;
+}
+
+}  // namespace
+
+std::vector<Outcome> runParallel(int n, int processes, const std::function<Outcome(int)>& fn) {
+  std::vector<Outcome> out(n, Outcome{"error"});
+  std::vector<bool> reported(n, false);
+  std::vector<int> pending(n);
+  for (int i = 0; i < n; ++i) pending[i] = i;
+  // A worker that crashes (a signal, e.g. an ODE assertion) takes down the trial it was running:
+  // that one stays "error"; the trials it had not reached run again in the next round, so that one
+  // bad cell does not cost its neighbours their results.
+  while (!pending.empty()) {
+    const std::vector<std::vector<int>> unfinished = runRound(pending, processes, fn, out, reported);
+    pending.clear();
+    for (const std::vector<int>& left : unfinished) {
+      if (left.empty()) continue;
+      std::fprintf(stderr, "sbot_validate: job %d crashed its worker and is marked error; %zu unfinished job(s) run again\n",
+                   left.front(), left.size() - 1);
+      pending.insert(pending.end(), left.begin() + 1, left.end());
+    }
+    std::sort(pending.begin(), pending.end());
   }
   return out;
 }

@@ -28,6 +28,18 @@ MismatchReasons MismatchReasons::load(const std::string& path, const std::string
   return r;
 }
 
+MismatchReasons MismatchReasons::none() {
+  MismatchReasons r;
+  r.source_ = "no reasons file (--reasons)";
+  return r;
+}
+
+std::vector<std::string> MismatchReasons::keys() const {
+  std::vector<std::string> k;
+  for (const auto& entry : reasons_) k.push_back(entry.first);
+  return k;
+}
+
 std::string MismatchReasons::record(const std::string& key, bool match) {
   if (match) {
     if (explains(key)) stale_.push_back(key);
@@ -52,7 +64,11 @@ std::string MismatchReasons::explainPending() {
   }
   pending_.clear();
   std::string md = "Why these cells do not match (`" + source_ + "`):\n\n";
-  for (const auto& [reason, cells] : groups) md += "- " + cells + ": " + reason + "\n";
+  for (const auto& [reason, cells] : groups) {
+    std::string one_line = reason;  // a line break would end the Markdown list item
+    std::replace(one_line.begin(), one_line.end(), '\n', ' ');
+    md += "- " + cells + ": " + one_line + "\n";
+  }
   return md + "\n";
 }
 

@@ -24,6 +24,11 @@ class MismatchReasons {
   /// and the problem: unreadable, not YAML, not a map, an empty key or a reason that is not a string.
   /// `shown_as`: how the report names the file (default: `path`).
   static MismatchReasons load(const std::string& path, const std::string& shown_as = "");
+  /// No reasons (a tables file of your own without a reasons file).
+  static MismatchReasons none();
+
+  /// The cells the file gives reasons for.
+  std::vector<std::string> keys() const;
 
   /// Whether the file records a reason for cell `key`.
   bool explains(const std::string& key) const { return reasons_.count(key) != 0; }

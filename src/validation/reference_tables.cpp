@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <iomanip>
+#include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -30,7 +31,8 @@ bool ReferenceTable::otherSpeeds() const {
 
 std::string NumberFormat::text(double v) const {
   std::ostringstream s;
-  s << std::fixed << std::setprecision(decimals) << v * scale;
+  if (decimals >= 0) s << std::fixed << std::setprecision(decimals) << v * scale;
+  else s << std::setprecision(6) << v * scale;  // no decimals given: the value as written, not rounded
   return s.str() + (unit.empty() ? "" : " " + unit);
 }
 
@@ -81,11 +83,15 @@ class Fields {
       return fallback;
     }
     if (!node_[k].IsScalar()) fail_(where_ + ": field '" + k + "' must be a text");
-    return node_[k].as<std::string>();
+    const std::string t = node_[k].as<std::string>();
+    if (required && t.empty()) fail_(where_ + ": field '" + k + "' is empty");
+    return t;
   }
+  /// A number; an empty text is not one (it used to read as the field's absence: `param: ""` ran a
+  /// 0 m gap).
   double number(const std::string& k, bool required, double fallback = 0) {
-    const std::string t = text(k, required, "");
-    if (t.empty()) return fallback;
+    if (!has(k)) return required ? (text(k, true), 0.0) : fallback;
+    const std::string t = text(k, false);
     char* end = nullptr;
     const double v = std::strtod(t.c_str(), &end);
     if (end == t.c_str() || *end != '\0' || !std::isfinite(v))
@@ -95,8 +101,8 @@ class Fields {
   /// The treels' Coulomb coefficient on a table's terrain: a number in (0, 100], or `lab_floor`
   /// (kLabFloorTrackMu); fallback when the field is absent (0: the experiment's own).
   double trackMu(const std::string& k, double fallback) {
-    const std::string t = text(k, false, "");
-    if (t.empty()) return fallback;
+    if (!has(k)) return fallback;
+    const std::string t = text(k, false);
     if (t == kLabFloorName) return kLabFloorTrackMu;
     char* end = nullptr;
     const double v = std::strtod(t.c_str(), &end);
@@ -146,8 +152,10 @@ NumberFormat readFormat(const YAML::Node& node, const std::string& where, const 
   n.header = f.text("header", default_header.empty(), default_header);
   n.unit = f.text("unit", false);
   n.scale = f.number("scale", false, 1);
-  const double decimals = f.number("decimals", false, 2);
-  if (decimals != std::round(decimals) || decimals < 0 || decimals > 6)
+  if (!(n.scale > 0 && n.scale <= 1e6))
+    fail(where + ": scale expects a number in (0, 1e6], found '" + f.text("scale", false) + "'");
+  const double decimals = f.number("decimals", false, -1);
+  if (decimals != -1 && (decimals != std::round(decimals) || decimals < 0 || decimals > 6))
     fail(where + ": decimals expects a whole number from 0 to 6, found '" + f.text("decimals", false) + "'");
   n.decimals = static_cast<int>(decimals);
   f.noOthers();
@@ -160,6 +168,11 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
   Fields f(node, where, fail);
   t.id = f.text("id", true);
   const std::string at = "table '" + t.id + "'";
+  if (t.id.find_first_of(", \n") != std::string::npos)
+    fail(at + ": an id may not hold a comma, space or line break (--only lists ids separated by commas)");
+  if (contains(vocabulary.sections, t.id))
+    fail(at + ": '" + t.id + "' is the name of a built-in section (" + joined(vocabulary.sections) +
+         "); give the table another id");
   t.title = f.text("title", true);
   t.about = f.text("about", false);
   t.group = f.text("group", false);
@@ -167,6 +180,11 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
   const std::string experiment = f.text("experiment", false);
   const std::string level = f.text("level", false);
   const std::string variant = f.text("variant", false);
+  // Texts that land in a Markdown table cell: a '|' or a line break would split the row.
+  const auto oneCell = [&](const std::string& where, const std::string& field, const std::string& text) {
+    if (text.find_first_of("|\n") != std::string::npos)
+      fail(where + ": " + field + " '" + text + "' holds a '|' or a line break, which would split the report's table");
+  };
   const double speed_units = f.number("speed_units", false, kSlowUnits);
   const double track_mu = f.trackMu("track_mu", 0);
   t.variant_header = f.text("variant_header", false);
@@ -198,6 +216,7 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
     c.experiment = cf.text("experiment", experiment.empty(), experiment);
     c.level = cf.text("level", level.empty(), level);
     c.variant = cf.text("variant", false, variant);
+    oneCell(cat, "variant", c.variant);
     c.param = cf.number("param", true);
     const double units = cf.number("speed_units", false, speed_units);
     if (units != std::round(units) || units < 1 || units > 70)
@@ -208,11 +227,18 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
     const ExperimentKind* kind = findExperimentKind(c.experiment);
     if (!kind || kind->labels.empty())
       fail(cat + ": experiment '" + c.experiment + "' is not one of " + experimentKindNames(true));
-    if (c.param < kind->min || c.param > kind->max) {
-      std::ostringstream m;
-      m << cat << ": param " << c.param << " is outside " << c.experiment << "'s range [" << kind->min << ", " << kind->max
-        << "] (" << kind->unit << ")";
-      fail(m.str());
+    // The companion runs on the same parameter: it must be of the same quantity and in its range.
+    for (const ExperimentKind* k : {kind, t.companion.empty() ? nullptr : findExperimentKind(t.companion)}) {
+      if (!k) continue;
+      if (k->unit != kind->unit)
+        fail(cat + ": the companion " + k->name + " takes a " + k->unit + ", the cell's " + c.experiment + " a " +
+             kind->unit + ": a companion runs on the cell's own parameter");
+      if (c.param < k->min || c.param > k->max) {
+        std::ostringstream m;
+        m << cat << ": param " << c.param << " is outside " << k->name << "'s range [" << k->min << ", " << k->max
+          << "] (" << k->unit << ")";
+        fail(m.str());
+      }
     }
     if (!contains(vocabulary.levels, c.level)) fail(cat + ": level '" + c.level + "' is not one of " + joined(vocabulary.levels));
     for (std::size_t r = 0; r < t.references.size(); ++r) {
@@ -230,6 +256,10 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
         vf.noOthers();
       }
       if (r == 0) {  // the compared column: every alternative must be a label the experiment yields
+        if (value.accepts.empty() || value.accepts.front() == '|' || value.accepts.back() == '|' ||
+            value.accepts.find("||") != std::string::npos)
+          fail(cat + ": reference '" + column + "' accepts '" + value.accepts +
+               "': every alternative between '|' must be a label (an empty one matches nothing)");
         std::stringstream ss(value.accepts);
         for (std::string label; std::getline(ss, label, '|');)
           if (!contains(kind->labels, label))
@@ -239,15 +269,21 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
         value.accepts.clear();
       }
       if (value.text.empty()) fail(cat + ": reference '" + column + "' is empty");
-      if (value.text.find('|') != std::string::npos)
-        fail(cat + ": reference '" + column + "' shows '" + value.text + "': a '|' would split the report's table");
+      oneCell(cat, "reference '" + column + "' shows", value.text);
       c.references.push_back(value);
     }
     cf.noOthers();
     t.cells.push_back(c);
   }
-  for (const ReferenceCell& c : t.cells)
-    if (!keys.insert(t.key(c)).second) fail(at + ": two cells are both '" + t.key(c) + "'");
+  std::map<std::string, const ReferenceCell*> by_key;
+  for (const ReferenceCell& c : t.cells) {
+    const auto [it, fresh] = by_key.emplace(t.key(c), &c);
+    if (fresh) continue;
+    if (it->second->param != c.param)  // distinct cells that the parameter's format shows alike
+      fail(at + ": the cells of param " + std::to_string(it->second->param) + " and " + std::to_string(c.param) +
+           " are both shown as '" + t.paramText(c) + "': give param: {decimals: ...} more decimals (or none)");
+    fail(at + ": two cells are both '" + t.key(c) + "'");
+  }
   f.noOthers();
   return t;
 }
@@ -297,6 +333,16 @@ ReferenceTables ReferenceTables::load(const std::string& path, const ReferenceVo
     e.noOthers();
     if (!names.insert(entry.name()).second) fail(where + ": '" + entry.name() + "' appears twice in the report");
     file.report.push_back(entry);
+  }
+  // A required group that nothing tallies would pass with no cell checked.
+  for (const ReferenceGroup& g : file.groups) {
+    if (!g.required) continue;
+    bool tallied = false;
+    for (const ReportEntry& e : file.report) {
+      tallied |= e.section.empty() && e.table.group == g.name;
+      for (const auto& [section, group] : vocabulary.section_groups) tallied |= e.section == section && group == g.name;
+    }
+    if (!tallied) fail("group '" + g.name + "' is required, but no table or section counts its cells in it");
   }
   return file;
 }

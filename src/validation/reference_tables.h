@@ -41,7 +41,7 @@ struct NumberFormat {
   std::string header;
   std::string unit;   ///< after the number ("mm"); may be empty
   double scale = 1;   ///< a gap in m shown in mm: 1000
-  int decimals = 2;
+  int decimals = -1;  ///< -1 (not given): the value as written, up to 6 significant digits
   std::string text(double v) const;  ///< "15 mm"
 };
 

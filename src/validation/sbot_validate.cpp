@@ -14,7 +14,8 @@
 // Exit status: 0 when every cell of the file's required groups (the seed's: the hardware cells of
 // Tables 4.1-4.3) matches, 1 otherwise, 2 on bad usage or when the report cannot be saved (--out is
 // created with its parents and checked before any trial; a report that fails to save at the end is
-// still printed on stdout).
+// still printed on stdout), 3 when a cell had trials that could not run (an exception or a crashed
+// worker; the report marks them "error" and lists the cells).
 //
 //   sbot_validate [--trace] [--index N] [--speed UNITS] [--track-mu MU|lab_floor] --trial KIND LEVEL PARAM    one trial, printed
 //     (tuning aid); --trace prints the robot's state every 0.1 s (pose, attitude, wheel load, track
@@ -124,6 +125,16 @@ struct Tally {
 
 /// The report's reasons for the cells that do not match (mismatch_reasons.h).
 v::MismatchReasons reasons;
+
+/// The cells the built-in section 4.1pair names (its rows are not cells of a tables file).
+/// Cells with a trial that could not run (an exception or a crashed worker, said on stderr): they
+/// are not mismatches of the model, and the exit status says so.
+std::vector<std::string> g_error_cells;
+
+const char* const kPairFullKey = "4.1 pair limit of full manoeuvrability";
+const char* const kPairStableKey = "4.1 pair limit of stable position";
+const char* const kPairStepSingleKey = "4.1.3 32 mm single s-bot";
+const char* const kPairStepTwoKey = "4.1.3 32 mm two connected";
 
 /// Tallies cell `key` and returns its match column; a mismatch is explained under its table.
 std::string mark(const std::string& key, bool ok, Tally& t) {
@@ -357,9 +368,9 @@ void writePairRows(std::ostream& md, const Options& o, Tally& hw) {
      << "| row | hardware | seed sim | ours (Coulomb mu " << fmt(v::kPolystyreneTrackMu, 1)
      << ") | match | ours (seed friction 1.2 N) | match |\n"
      << "|---|---|---|---|---|---|---|\n"
-     << "| limit of full manoeuvrability | 29 deg | 29 deg | " << fmt(ours.full, 0) << " deg | " << mark("4.1 pair limit of full manoeuvrability", full_ok, hw)
+     << "| limit of full manoeuvrability | 29 deg | 29 deg | " << fmt(ours.full, 0) << " deg | " << mark(kPairFullKey, full_ok, hw)
      << " | " << fmt(seed.full, 0) << " deg | " << (fullOk(seed) ? "match" : "mismatch") << " |\n"
-     << "| limit of stable position | 58-72 deg | 58-72 deg | " << stableText(ours) << " | " << mark("4.1 pair limit of stable position", stable_ok, hw)
+     << "| limit of stable position | 58-72 deg | 58-72 deg | " << stableText(ours) << " | " << mark(kPairStableKey, stable_ok, hw)
      << " | " << stableText(seed) << " | " << (stableOk(seed) ? "match" : "mismatch") << " |\n\n"
      << reasons.explainPending() << "Per slope, Coulomb: " << ours.detail << "\n\nPer slope, seed friction: " << seed.detail << "\n\n"
      << "What separates the two rows is the treels' creep (`treels.creep_stiffness`, sbot_parameters.yaml): "
@@ -387,9 +398,9 @@ void writePairRows(std::ostream& md, const Options& o, Tally& hw) {
         "robots' own sensors through sbot.h is sbot_controllers/src/step_climbing.c, rostest "
         "test/two_sbots_step.test, on the simulator's default floor).\n\n"
      << "| step | robots | real s-bots | seed sim | ours | match |\n|---|---|---|---|---|---|\n"
-     << "| 32 mm | single s-bot | topple | topple | " << ms.text << " (" << summary(single) << ") | " << mark("4.1.3 32 mm single s-bot", single_ok, hw)
+     << "| 32 mm | single s-bot | topple | topple | " << ms.text << " (" << summary(single) << ") | " << mark(kPairStepSingleKey, single_ok, hw)
      << " |\n"
-     << "| 32 mm | two connected | pass | pass | " << mp.text << " (" << summary(pair) << ") | " << mark("4.1.3 32 mm two connected", pair_ok, hw)
+     << "| 32 mm | two connected | pass | pass | " << mp.text << " (" << summary(pair) << ") | " << mark(kPairStepTwoKey, pair_ok, hw)
      << " |\n\n" << reasons.explainPending();
 }
 
@@ -600,6 +611,7 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
     const v::ReferenceCell& c = t.cells[k];
     const std::vector<Outcome> ours = outcomes(0, k);
     const ModalCell m = modalCell(c.references.front().accepts, ours);
+    if (std::any_of(ours.begin(), ours.end(), failed)) g_error_cells.push_back(t.key(c));
     md << "| " << t.paramText(c);
     if (!t.variant_header.empty()) md << " | " << c.variant;
     if (levels) md << " | " << c.level;
@@ -674,6 +686,7 @@ int main(int argc, char** argv) {
   int index = 0;  // --index: which trial of a cell --trial runs (its start perturbation)
   v::Drive drive;  // --speed: the labelled trials' setSpeed units (default: the seed's 2.8 cm/s)
   std::string scenario_file;  // --scenario: write --trial's world as a scenario file instead of running it
+  std::vector<std::string> trial_options;  // given options that only --trial reads
   sbot_tools::ArgReader args("sbot_validate", argc, argv);
   while (args.more()) {
     const std::string a = args.option();
@@ -685,13 +698,14 @@ int main(int argc, char** argv) {
     else if (a == "--reasons") o.reasons = args.value();
     else if (a == "--tables") o.tables = args.value();
     else if (a == "--trace") trace = true;  // with --trial (before it): the robot's state every 0.1 s
-    else if (a == "--index") index = args.count(0, 999);  // with --trial (before it): the cell's trial N
-    else if (a == "--speed") drive.units = args.count(1, 70);  // with --trial (before it): setSpeed units
+    else if (a == "--index") index = args.count(0, 999), trial_options.push_back(a);  // with --trial: the cell's trial N
+    else if (a == "--speed") drive.units = args.count(1, 70), trial_options.push_back(a);  // with --trial: setSpeed units
     else if (a == "--track-mu") {  // with --trial (before it): the treels' mu on the terrain (a table's track_mu)
       const std::string m = args.value();
       drive.track_mu = m == v::kLabFloorName ? v::kLabFloorTrackMu : sbot_tools::numberArg(args.tool(), "--track-mu", m, 1e-6, 100);
+      trial_options.push_back(a);
     }
-    else if (a == "--scenario") scenario_file = args.value();  // with --trial (before it): write, do not run
+    else if (a == "--scenario") scenario_file = args.value(), trial_options.push_back(a);  // with --trial: write, do not run
     else if (a == "--trial") {  // --trial KIND LEVEL PARAM: one trial, printed (tuning aid)
       const std::string kind = args.value(), level = args.value();
       const v::ExperimentKind* k = v::findExperimentKind(kind);
@@ -713,7 +727,12 @@ int main(int argc, char** argv) {
       return 0;
     }
     else if (a == "--only") {
-      std::stringstream ss(args.value());
+      const std::string list = args.value();
+      if (list.empty()) {  // an empty shell variable would otherwise run the whole suite
+        std::fprintf(stderr, "sbot_validate: --only expects a list of sections and table ids, found ''\n");
+        return 2;
+      }
+      std::stringstream ss(list);
       for (std::string s; std::getline(ss, s, ',');) o.only.insert(s);
     } else {
       std::fprintf(stderr, "usage: sbot_validate --out DIR [--quick] [--trials N] [--jobs N] [--only LIST]\n"
@@ -725,6 +744,11 @@ int main(int argc, char** argv) {
   }
   if (trace) {  // a whole report's trials would interleave their traces from the worker processes
     std::fprintf(stderr, "sbot_validate: --trace goes with --trial (before it): one trial, traced\n");
+    return 2;
+  }
+  if (!trial_options.empty()) {  // the report would run without them, at the tables' own values
+    std::fprintf(stderr, "sbot_validate: %s goes with --trial (before it); a report takes its speeds and floors from the tables\n",
+                 trial_options.front().c_str());
     return 2;
   }
   if (o.quick) { o.trials = std::min(o.trials, 3); o.rough_runs = 4; }
@@ -767,11 +791,25 @@ int main(int argc, char** argv) {
     }
   }
   try {  // before any work: a report whose mismatches cannot be explained is not written
-    reasons = o.reasons.empty() ? v::MismatchReasons::load(source_dir + "/" + v::kMismatchReasonsFile, v::kMismatchReasonsFile)
-                                : v::MismatchReasons::load(o.reasons);
+    // Your own tables without --reasons: the seed's reasons are about the seed's cells, and would
+    // "explain" a cell of yours that happens to share a name.
+    if (!o.reasons.empty()) reasons = v::MismatchReasons::load(o.reasons);
+    else if (o.tables.empty()) reasons = v::MismatchReasons::load(source_dir + "/" + v::kMismatchReasonsFile, v::kMismatchReasonsFile);
+    else reasons = v::MismatchReasons::none();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "sbot_validate: --reasons: %s\n", e.what());
     return 2;
+  }
+  {  // a reason whose key names no cell (a typo) would never be shown: say so before the work
+    std::set<std::string> keys;
+    for (const v::ReportEntry& e : tables.report) {
+      for (const v::ReferenceCell& c : e.table.cells) keys.insert(e.table.key(c));
+      if (e.section == "4.1pair") keys.insert({kPairFullKey, kPairStableKey, kPairStepSingleKey, kPairStepTwoKey});
+    }
+    for (const std::string& k : reasons.keys())
+      if (!keys.count(k))
+        std::fprintf(stderr, "sbot_validate: warning: %s: the reason for '%s' names no cell of %s\n", reasons.source().c_str(),
+                     k.c_str(), tables.source.c_str());
   }
   for (const std::string& level : kAllLevels)  // before any work: every trial of that level would fail on it
     sbot_tools::requireLevel("sbot_validate", "model description of level '" + level + "' (or $SBOT_DESCRIPTION_DIR)", level);
@@ -824,6 +862,8 @@ int main(int argc, char** argv) {
     for (const std::string& k : keys) s += (s.empty() ? "" : "; ") + k;
     return s;
   };
+  if (!g_error_cells.empty())
+    md << "- Cells with trials that could not run (\"error\"; the cause is on stderr): " << cells(g_error_cells) << "\n";
   if (!reasons.unexplained().empty())
     md << "- Mismatches not explained yet (new since the analysis): " << cells(reasons.unexplained()) << "\n";
   if (!reasons.stale().empty())
@@ -840,5 +880,10 @@ int main(int argc, char** argv) {
     return 2;
   }
   progress("wrote " + o.out + "/report.md (" + counts + ")");
+  if (!g_error_cells.empty()) {
+    std::fprintf(stderr, "sbot_validate: %zu cell(s) had trials that could not run: %s\n", g_error_cells.size(),
+                 cells(g_error_cells).c_str());
+    return 3;
+  }
   return required_match ? 0 : 1;
 }

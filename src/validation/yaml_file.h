@@ -2,6 +2,8 @@
 // same two refusals: a file that cannot be read, and one that is not YAML (with the parser's line).
 #pragma once
 
+#include <sys/stat.h>
+
 #include <stdexcept>
 #include <string>
 
@@ -14,6 +16,8 @@ namespace validation {
 
 /// The parsed file; throws std::runtime_error("<what> <path>: cannot be read" / ": not YAML (...)").
 inline YAML::Node loadYamlFile(const std::string& what, const std::string& path) {
+  struct stat st;
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) throw std::runtime_error(what + " " + path + ": is a directory");
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);

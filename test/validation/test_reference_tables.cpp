@@ -176,7 +176,17 @@ TEST(ReferenceTables, MalformedFilesAreRefusedWithTheEntryAndTheProblem) {
       {with("{param: 0.035, level: basic, measured: pass}", "{param: 0.030, measured: stuck}"),
         "two cells are both 'lab1 30 mm'"},
       {with("        - {param: 0.030, measured: pass}\n", "        - {param: 0.030, measured: {accepts: pass, text: \"a|b\"}}\n"),
-        "a '|' would split the report's table"},
+        "holds a '|' or a line break, which would split the report's table"},
+      // Outside probe, 2026-11-28:
+      {with("param: 0.060", "param: \"\""), "cell 1: field 'param' expects a finite number, found ''"},  // was a 0 m gap
+      {with("measured: pass}", "measured: {accepts: \"\", text: pass}}"), "field 'accepts' is empty"},
+      {with("measured: pass}", "measured: \"pass|\"}"), "every alternative between '|' must be a label"},
+      {with("level: basic, ", "level: basic, variant: \"a|b\", "), "variant 'a|b' holds a '|' or a line break"},
+      {with("id: lab1", "id: \"4.4\""), "'4.4' is the name of a built-in section"},  // it started the RTM runs
+      {with("id: lab1", "id: \"lab,1\""), "an id may not hold a comma"},
+      {with("      group: lab\n", ""), "group 'lab' is required, but no table or section counts its cells in it"},
+      {with("{param: 0.035, level: basic, measured: pass}", "{param: 0.0301, measured: stuck}") + "",
+        "the cells of param 0.030000 and 0.030100 are both shown as '30 mm'"},
       {with("level: basic, ", "level: basic, speed_units: 2.5, "), "cell 2: speed_units expects a whole number of setSpeed units in [1, 70]"},
       {with("level: medium\n", "level: medium\n      speed_units: 71\n"), "cell 0: speed_units expects a whole number"},
       {with("level: basic, ", "level: basic, track_mu: -0.5, "),

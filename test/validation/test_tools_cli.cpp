@@ -188,6 +188,42 @@ TEST(ToolsCli, AnotherReferenceTableRunsAndDecidesTheExitStatus) {
                 "--only: unknown section '4.5' (in " + dir + "ok.yaml: lab1)");
 }
 
+// Findings of an outside probe (2026-11-28): a 0 mm step stopped ODE with an assertion (and cost
+// the worker's other cells), options only --trial reads were ignored by a report, an empty --only
+// ran the whole suite, the seed's reasons "explained" cells of another tables file, and a reason
+// whose key names no cell was silently never shown.
+TEST(ToolsCli, ProbedTablesAndOptionsAreRunOrRefusedAsTheySay) {
+  const std::string dir = testing::TempDir() + "cli_probe/";
+  std::system(("mkdir -p " + dir).c_str());
+  const Outcome zero = run("sbot_validate", "--trial step detailed 0");
+  EXPECT_EQ(zero.status, 0) << zero.output;
+  EXPECT_NE(zero.output.find("step detailed 0: pass"), std::string::npos) << "a 0 mm step is the floor: " << zero.output;
+  const Outcome flat = run("sbot_validate", "--trial downhill detailed 0");
+  EXPECT_EQ(flat.status, 0) << flat.output;
+  const std::string out = "--out " + dir + "x ";
+  expectRefused("sbot_validate", out + "--speed 30", "--speed goes with --trial (before it)");
+  expectRefused("sbot_validate", out + "--index 5", "--index goes with --trial (before it)");
+  expectRefused("sbot_validate", out + "--only \"\"", "--only expects a list of sections and table ids, found ''");
+  expectRefused("sbot_validate", out + "--tables " + dir, "--tables: reference tables " + dir + ": is a directory");
+  // A table of one's own, named like a seed cell, mismatching: the seed's reason is not shown for it.
+  std::ofstream(dir + "mine.yaml") << "groups:\n  - {name: mine, title: Mine}\n"
+                                      "report:\n  - table:\n      id: \"4.5\"\n      title: Mine\n      group: mine\n      experiment: gap\n"
+                                      "      param: {unit: cm, scale: 100, decimals: 1}\n      references: [measured]\n"
+                                      "      cells:\n        - {param: 0.040, level: simple, measured: pass}\n"
+                                      "        - {param: 0.030, level: fast, measured: pass}\n";
+  const Outcome mine = run("sbot_validate", "--trials 1 --jobs 1 " + out + "--tables " + dir + "mine.yaml");
+  EXPECT_NE(mine.output.find("| 4.0 cm | simple | pass | stuck"), std::string::npos) << mine.output;
+  EXPECT_NE(mine.output.find("*4.5 4.0 cm simple*: **not explained yet**"), std::string::npos) << mine.output;
+  // With a reasons file that names a cell the tables do not have: a warning naming it.
+  std::ofstream(dir + "reasons.yaml") << "\"4.5 4.0 cm simple\": why\n\"4.5 40 mm simple\": a typo\n";
+  const Outcome typo = run("sbot_validate", "--trials 1 --jobs 1 " + out + "--tables " + dir + "mine.yaml --reasons " + dir +
+                                                 "reasons.yaml");
+  EXPECT_NE(typo.output.find("warning: " + dir + "reasons.yaml: the reason for '4.5 40 mm simple' names no cell"),
+            std::string::npos)
+      << typo.output;
+  EXPECT_NE(typo.output.find("*4.5 4.0 cm simple*: why"), std::string::npos) << typo.output;
+}
+
 // A table's cells can drive at another speed than the seed's 2.8 cm/s (speed_units): the Medium is
 // stuck in a 4 cm gap at 2.8 cm/s and crosses it on its momentum at 16.8 cm/s (the seed's reason for
 // driving slowly, 4.2.3); the report then shows each cell's speed.

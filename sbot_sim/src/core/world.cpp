@@ -151,6 +151,8 @@ void World::buildTerrain() {
   for (const auto& box : t.boxes) {
     std::string problem = positionProblem(box.center);
     if (problem.empty()) problem = positionProblem(box.size);
+    // A box without volume is degenerate for ODE's collision tests (an assertion, not an error).
+    if (problem.empty() && !(box.size.array() > 0).all()) problem = "every edge of a box must be > 0";
     if (!problem.empty()) throw ConfigError("<world>", "terrain.boxes (" + box.name + ")", problem);
   }
   if (t.type == TerrainConfig::Type::Rough) {
