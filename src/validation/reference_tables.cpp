@@ -106,8 +106,8 @@ class Fields {
     if (t == kLabFloorName) return kLabFloorTrackMu;
     char* end = nullptr;
     const double v = std::strtod(t.c_str(), &end);
-    if (end == t.c_str() || *end != '\0' || !(v > 0 && v <= 100))
-      fail_(where_ + ": field '" + k + "' expects a friction coefficient in (0, 100] or lab_floor, found '" + t + "'");
+    if (end == t.c_str() || *end != '\0' || !(v >= 1e-6 && v <= 100))  // --track-mu's range
+      fail_(where_ + ": field '" + k + "' expects a friction coefficient in [1e-6, 100] or lab_floor, found '" + t + "'");
     return v;
   }
   bool flag(const std::string& k) {
@@ -191,6 +191,9 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
   if (f.has("param")) t.param = readFormat(f.node("param"), at + ", param", t.param.header, fail);
   t.references = f.list("references");
   if (t.references.empty()) fail(at + ": 'references' must name at least one column (the first is compared)");
+  for (const std::string& column : t.references)  // a cell's own fields cannot also be its columns
+    for (const char* field : {"param", "experiment", "level", "variant", "speed_units", "track_mu"})
+      if (column == field) fail(at + ": the reference column '" + column + "' has the name of a cell's field; rename it");
   t.ours_header = f.text("ours_header", false, t.ours_header);
   if (f.has("companion")) {
     Fields c(f.node("companion"), at + ", companion", fail);

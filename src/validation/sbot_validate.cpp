@@ -716,6 +716,11 @@ int main(int argc, char** argv) {
       sbot_tools::requireLevel("sbot_validate", "--trial " + kind + " " + level, level);
       const double p = sbot_tools::numberArg(args.tool(), "--trial " + kind + " " + level + " (" + k->unit + ")",
                                              args.value(), k->min, k->max);
+      if (kind == "speed" && p != std::round(p)) {  // setSpeed takes whole units: 0.4 would drive at 0
+        std::fprintf(stderr, "sbot_validate: --trial speed %s expects a whole number of setSpeed units, found %g\n",
+                     level.c_str(), p);
+        return 2;
+      }
       if (!scenario_file.empty()) return writeTrialScenario(scenario_file, *k, level, p, index, drive);
       v::setTrace(trace);
       v::setRoughHeightmap(findHeightmap());
