@@ -591,12 +591,23 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
     return n ? t.value.text(sum / n) : std::string("error");
   };
   const bool tallied = !t.group.empty(), levels = t.severalLevels(), speeds = t.otherSpeeds();
+  // Rows must not differ only in what the table does not show: cells' variants without a
+  // variant_header, and floors of their own (track_mu), get a column too.
+  const bool variants = !t.variant_header.empty() ||
+                        std::any_of(t.cells.begin(), t.cells.end(), [](const v::ReferenceCell& c) { return !c.variant.empty(); });
+  const bool floors = std::any_of(t.cells.begin(), t.cells.end(),
+                                  [&](const v::ReferenceCell& c) { return c.track_mu != t.cells.front().track_mu; });
   md << "## " << t.title << " (modal of " << o.trials << ")\n\n";
   if (!t.about.empty()) md << t.about << "\n\n";
+  if (std::any_of(t.cells.begin(), t.cells.end(), [](const v::ReferenceCell& c) { return c.level == "fast"; }) &&
+      (t.about.find("halved") == std::string::npos))
+    md << "The half-size Fast robot meets gaps and run-ups halved (seed 4.2.2): its cells' parameters are the "
+          "full-size values.\n\n";
   std::vector<std::string> columns{t.param.header};
-  if (!t.variant_header.empty()) columns.push_back(t.variant_header);
+  if (variants) columns.push_back(t.variant_header.empty() ? "variant" : t.variant_header);
   if (levels) columns.push_back("level");
   if (speeds) columns.push_back("speed [cm/s]");
+  if (floors) columns.push_back("treels mu");
   columns.insert(columns.end(), t.references.begin(), t.references.end());
   columns.push_back(t.ours_header);
   if (tallied) columns.push_back("match");
@@ -613,9 +624,10 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
     const ModalCell m = modalCell(c.references.front().accepts, ours);
     if (std::any_of(ours.begin(), ours.end(), failed)) g_error_cells.push_back(t.key(c));
     md << "| " << t.paramText(c);
-    if (!t.variant_header.empty()) md << " | " << c.variant;
+    if (variants) md << " | " << c.variant;
     if (levels) md << " | " << c.level;
     if (speeds) md << " | " << fmt(v::Drive{c.speed_units}.speed(sbot::loadLevel(c.level)) * 100, 2);
+    if (floors) md << " | " << (c.track_mu > 0 ? fmt(c.track_mu, 3) : std::string("the experiment's"));
     for (const v::ReferenceValue& r : c.references) md << " | " << r.text;
     md << " | " << m.text << " (" << summary(ours) << ")";
     if (tallied) {
