@@ -101,6 +101,27 @@ def read_run(bag_path, topics):
     return rows, (first_pose[1] if first_pose else None), missing
 
 
+LEVELS = ["fast", "simple", "basic", "medium", "detailed"]  # the model levels (sbot::modelLevels)
+
+
+def read_world(path):
+    """The `world:` mapping of a --world file (or the file itself as that mapping); SystemExit naming
+    the file when it cannot be read or holds something else."""
+    try:
+        with open(path) as f:
+            w = yaml.safe_load(f)
+    except OSError as error:
+        raise SystemExit("bag_to_dataset: --world: cannot read %s: %s" % (path, error.strerror))
+    except yaml.YAMLError as error:
+        raise SystemExit("bag_to_dataset: --world %s: not valid YAML: %s" % (path, error))
+    if isinstance(w, dict) and "world" in w:
+        w = w["world"]
+    if not isinstance(w, dict):
+        raise SystemExit("bag_to_dataset: --world %s: expected the dataset's world mapping (terrain, obstacles, "
+                         "lamps ...), found %s" % (path, "nothing" if w is None else type(w).__name__))
+    return w
+
+
 ORDER = ["cmd_left", "cmd_right", "x", "y", "yaw", "speed_left", "speed_right", "torque_left", "torque_right",
          "pitch", "roll"] + ["ir%d" % k for k in range(15)] + ["ground%d" % k for k in range(4)] + \
         ["light%d" % k for k in range(8)]
@@ -131,7 +152,7 @@ def main(argv=None):
     p.add_argument("out", help="dataset directory (created)")
     p.add_argument("bags", nargs="+", help="bag files, one run each")
     p.add_argument("--robot", default="sbot_0", help="robot namespace (default sbot_0)")
-    p.add_argument("--level", default="medium", help="model level of the dataset (default medium)")
+    p.add_argument("--level", default="medium", choices=LEVELS, help="model level of the dataset (default medium)")
     p.add_argument("--name", default=None, help="dataset name (default: the directory name)")
     p.add_argument("--run-name", default=None, help="run name (single bag only)")
     p.add_argument("--world", default=None, help="YAML file with the dataset's world mapping")
@@ -159,9 +180,7 @@ def main(argv=None):
               "description": "imported from rosbag by bag_to_dataset.py", "robot": a.level,
               "world": {"terrain": {"type": "plane"}}, "runs": []}
     if a.world:
-        with open(a.world) as f:
-            w = yaml.safe_load(f)
-        ds["world"] = w.get("world", w)
+        ds["world"] = read_world(a.world)
     # Read every bag before writing anything: an unreadable bag stops the import with its name and
     # leaves the output directory as it was (no CSV without its dataset.yaml entry).
     imported = []

@@ -106,20 +106,30 @@ Evaluation merge(const std::vector<Evaluation>& parts) {
 
 }  // namespace
 
+std::string unmeasuredChannels(const Dataset& ds, const std::string& name) {
+  const EffectInfo& info = EffectRegistry::instance().info(name);
+  const std::set<std::string> groups = usableGroups(ds);
+  std::string acts_on, measured;
+  for (const auto& c : info.channels) {
+    if (c == "pose" ? groups.count("position") || groups.count("yaw") : groups.count(c)) return "";
+    acts_on += (acts_on.empty() ? "" : ", ") + c;
+  }
+  for (const auto& g : groups) measured += (measured.empty() ? "" : ", ") + g;
+  const std::string dataset = "dataset '" + ds.name + "'";
+  return name + " acts on " + acts_on +
+         (info.channels.size() > 1 ? ", none of which " + dataset + " measures" : ", which " + dataset + " does not measure") +
+         " (it measures " + (measured.empty() ? "nothing the replay simulates" : measured) + ")";
+}
+
+std::string missingSurfaces(const Dataset& ds, const std::string& name) {
+  if (!EffectRegistry::instance().info(name).open_params || !ds.obstacleSurfaces().empty()) return "";
+  return name + " has one parameter per surface, and dataset '" + ds.name + "' has no obstacle with a surface";
+}
+
 std::vector<std::string> candidateEffects(const Dataset& ds) {
   std::vector<std::string> out;
-  const EffectRegistry& reg = EffectRegistry::instance();
-  const std::set<std::string> groups = usableGroups(ds);
-  for (const auto& name : reg.names()) {
-    const EffectInfo& info = reg.info(name);
-    if (info.open_params && ds.obstacleSurfaces().empty()) continue;  // per-surface: needs surfaces
-    bool visible = false;
-    for (const auto& c : info.channels) {
-      if (c == "pose") visible |= groups.count("position") || groups.count("yaw");
-      else visible |= groups.count(c) != 0;
-    }
-    if (visible) out.push_back(name);
-  }
+  for (const auto& name : EffectRegistry::instance().names())
+    if (unmeasuredChannels(ds, name).empty() && missingSurfaces(ds, name).empty()) out.push_back(name);
   return out;
 }
 
@@ -158,6 +168,8 @@ std::vector<std::string> candidateParams(const Dataset& ds, const std::string& n
   }
   return out;
 }
+
+int foldCount(const Dataset& ds, int folds) { return std::max(1, std::min<int>(folds, static_cast<int>(ds.runs.size()))); }
 
 std::vector<int> assignFolds(const Dataset& ds, int folds, std::uint64_t seed) {
   std::vector<int> fold(ds.runs.size(), 0);
@@ -295,7 +307,7 @@ DiagnoseResult diagnose(const Dataset& ds, const DiagnoseOptions& opt, WorkerPoo
   const auto t0 = std::chrono::steady_clock::now();
   const long sims0 = replayCount();
   DiagnoseResult out;
-  const int K = std::max(1, std::min<int>(opt.folds, static_cast<int>(ds.runs.size())));
+  const int K = foldCount(ds, opt.folds);
   out.fold_of_run = assignFolds(ds, K, opt.seed);
   std::vector<std::vector<int>> train(K), test(K);
   for (std::size_t i = 0; i < ds.runs.size(); ++i) {

@@ -98,10 +98,21 @@ DiagnoseResult diagnose(const Dataset& ds, const DiagnoseOptions& opt, WorkerPoo
 /// Library effects a dataset can reveal (their channels are measured and simulated).
 std::vector<std::string> candidateEffects(const Dataset& ds);
 
+/// "" when `ds` measures (and the replay simulates) a channel the effect acts on; else why not, e.g.
+/// "ir_incidence acts on ir, which dataset 'x' does not measure (it measures position, yaw)". Fitting
+/// such an effect leaves it at its start with a meaningless interval.
+std::string unmeasuredChannels(const Dataset& ds, const std::string& effect);
+/// "" unless the effect's parameters are per surface (ir_reflectance) and `ds` has no obstacle with
+/// a surface label to give it one (candidateConfig would give it no parameter).
+std::string missingSurfaces(const Dataset& ds, const std::string& effect);
+
 /// The configuration a candidate effect starts from (open-parameter effects get one parameter per
 /// obstacle surface of the dataset) and the names of its free parameters, in fit order.
 EffectConfig candidateConfig(const Dataset& ds, const std::string& name);
 std::vector<std::string> candidateParams(const Dataset& ds, const std::string& name);
+
+/// The folds diagnose uses for `folds` requested: at most one per run (one run: 1, in-sample).
+int foldCount(const Dataset& ds, int folds);
 
 /// Split runs into folds: runs of each experiment group are dealt round-robin (shuffled by seed),
 /// so every fold sees every kind of experiment when there are enough runs.

@@ -1,7 +1,10 @@
 #include "calibration/generator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <sstream>
+#include <stdexcept>
 
 #include "calibration/codec.h"
 #include "calibration/replay.h"
@@ -153,6 +156,46 @@ const std::vector<std::string>& generatorFamilies() {
   return f;
 }
 
+void checkGeneratorOptions(const GeneratorOptions& opt) {
+  auto fmtNumber = [](double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+  };
+  auto list = [](const std::vector<std::string>& v) {
+    std::string s;
+    for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+    return s;
+  };
+  for (const auto& f : opt.experiments)
+    if (std::find(generatorFamilies().begin(), generatorFamilies().end(), f) == generatorFamilies().end())
+      throw std::invalid_argument("--families: unknown family '" + f + "' (known: " + list(generatorFamilies()) + ")");
+  // A drive run drives for duration - 1 s and stands for the last second (drivePatterns); a dataset
+  // refuses runs beyond an hour.
+  if (!(opt.duration >= kMinDuration && opt.duration <= kMaxRunDuration))
+    throw std::invalid_argument("--duration expects " + fmtNumber(kMinDuration) + " to " + fmtNumber(kMaxRunDuration) +
+                                " s (each drive run drives for duration - 1 s, then stands for 1 s), got " +
+                                fmtNumber(opt.duration));
+  // An unnoticed floor slope: the s-bot is fully manoeuvrable up to 29 deg (seed Table 4.1, the
+  // creep calibration in sbot_parameters.yaml); beyond, it creeps back or slides, and the downhill
+  // direction is drawn at random, so a negative tilt says nothing more.
+  if (!(opt.tilt_deg >= 0 && opt.tilt_deg <= kMaxTiltDeg))
+    throw std::invalid_argument("--tilt expects a floor tilt from 0 to " + fmtNumber(kMaxTiltDeg) +
+                                " deg (the s-bot drives freely up to ~29 deg; the downhill direction is random), got " +
+                                fmtNumber(opt.tilt_deg));
+  for (const char* f : {"place", "approach"}) {
+    if (!opt.experiments.count(f)) continue;
+    // Look-up-table levels see other s-bots, not walls (proximity.h): the walls' runs would be noise only.
+    auto rayTraced = [](const std::string& level) { return loadLevel(level).extraOr("ir_model", "raytrace") == "raytrace"; };
+    if (rayTraced(opt.level)) continue;
+    std::vector<std::string> levels;
+    for (const auto& l : modelLevels())
+      if (rayTraced(l)) levels.push_back(l);
+    throw std::invalid_argument("--families " + std::string(f) + " needs a level with ray-traced IR (" + list(levels) +
+                                "); level '" + opt.level + "' reads IR from a look-up table of other s-bots that does not see walls");
+  }
+}
+
 Dataset generateDataset(const GeneratorOptions& opt, WorkerPool& pool, GeneratedTruth* truth) {
   Dataset ds;
   ds.name = opt.name;
@@ -162,6 +205,7 @@ Dataset generateDataset(const GeneratorOptions& opt, WorkerPool& pool, Generated
   ds.align_segment = opt.align_segment;
   ds.description = "synthetic dataset (sbot_calibrate generate, seed " + std::to_string(opt.seed) + ")";
   loadLevel(opt.level);  // fail early on an unknown level
+  checkGeneratorOptions(opt);
 
   // The world the "real" robot drives in: the dataset's (flat) world, possibly tilted (gravity).
   WorldConfig real = ds.world;

@@ -49,4 +49,14 @@ Dataset generateDataset(const GeneratorOptions& opt, WorkerPool& pool, Generated
 /// Families the generator knows.
 const std::vector<std::string>& generatorFamilies();
 
+/// Least GeneratorOptions::duration [s] (at most kMaxRunDuration) and largest tilt_deg [deg]
+/// (reasons in checkGeneratorOptions).
+constexpr double kMinDuration = 2, kMaxTiltDeg = 30;
+
+/// Throws std::invalid_argument naming the option (--families, --duration, --tilt) for an unknown
+/// family, a duration or tilt outside its range, or IR families (place, approach) on a level whose
+/// IR is a look-up table (no walls in it). generateDataset checks too; the command line calls it
+/// before it creates the output folder.
+void checkGeneratorOptions(const GeneratorOptions& opt);
+
 }  // namespace sbot::calib

@@ -11,11 +11,22 @@
 //   common: --jobs N (worker processes, default: all cores), --quiet; compare/diagnose/fit also
 //           --solver quickstep|exact (replaces the dataset's world stepper)
 // Output places (--out, --write-effects) are created and checked before the work: a fit or a
-// diagnosis runs for minutes, and its result must not be lost to an unwritable path at the end.
+// diagnosis runs for minutes, and its result must not be lost to an unwritable path at the end. They
+// are checked after the input (dataset, effects, option values), so a refused run creates no folder.
+#include <dirent.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <chrono>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -30,6 +41,7 @@
 #include "sbot_sim/core/effects/effect_registry.h"
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/output_files.h"
+#include "sbot_sim/core/robot_description.h"
 
 using namespace sbot;
 using namespace sbot::calib;
@@ -52,14 +64,36 @@ struct Args {
     for (auto [a, b] = opts.equal_range(k); a != b; ++a) v.push_back(a->second);
     return v;
   }
+  /// A finite number (strtod also reads "nan" and "inf", which no option means).
   double num(const std::string& k, double def) const {
     if (!opts.count(k)) return def;
     char* end = nullptr;
     const std::string s = get(k);
     const double v = std::strtod(s.c_str(), &end);
     if (end == s.c_str() || *end) throw std::invalid_argument("--" + k + " expects a number, got '" + s + "'");
+    if (!std::isfinite(v)) throw std::invalid_argument("--" + k + " expects a finite number, got '" + s + "'");
     return v;
   }
+  /// A whole number in [lo, hi] (`why`: what the bound means, may be empty). Not strtod's: "2.5"
+  /// folds or a seed beyond 2^63 would be cut silently.
+  long long whole(const std::string& k, long long def, long long lo, long long hi, const std::string& why = "") const {
+    if (!opts.count(k)) return def;
+    const std::string s = get(k);
+    char* end = nullptr;
+    errno = 0;
+    const long long v = std::strtoll(s.c_str(), &end, 10);
+    const bool starts = !s.empty() && (std::isdigit(static_cast<unsigned char>(s[0])) || s[0] == '-' || s[0] == '+');
+    if (starts && end != s.c_str() && !*end && errno != ERANGE && v >= lo && v <= hi) return v;
+    const std::string range = hi == INT_MAX ? "of at least " + std::to_string(lo)
+                                              : "from " + std::to_string(lo) + " to " + std::to_string(hi);
+    throw std::invalid_argument("--" + k + " expects a whole number " + range + (why.empty() ? "" : " (" + why + ")") +
+                                ", got '" + s + "'");
+  }
+};
+
+/// An unknown subcommand: named, then the usage.
+struct UnknownCommand : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
 };
 
 const std::set<std::string> kFlags{"no-plots", "quiet", "no-align", "torque", "no-tilt", "no-speed", "verbose", "help"};
@@ -79,7 +113,7 @@ const std::map<std::string, std::set<std::string>> kCommandOptions{
 /// Refuse an option the subcommand does not read (a misspelt one would otherwise be ignored).
 void refuseUnknownOption(const std::string& cmd, const std::string& k) {
   auto it = kCommandOptions.find(cmd);
-  if (it == kCommandOptions.end()) return;  // unknown command: usage() says so
+  if (it == kCommandOptions.end()) return;  // help (parse() refuses unknown commands)
   if (it->second.count(k) || k == "jobs" || k == "quiet" || k == "help") return;
   std::string accepted;
   for (const auto& o : it->second) accepted += " --" + o;
@@ -87,10 +121,17 @@ void refuseUnknownOption(const std::string& cmd, const std::string& k) {
                               (accepted.empty() ? std::string(" none") : accepted) + ", and --jobs, --quiet)");
 }
 
+bool isHelp(const std::string& cmd) { return cmd == "--help" || cmd == "help" || cmd == "-h"; }
+
 Args parse(int argc, char** argv) {
   Args a;
   if (argc < 2) return a;
   a.cmd = argv[1];
+  if (!kCommandOptions.count(a.cmd) && !isHelp(a.cmd)) {
+    std::string known;
+    for (const auto& [c, o] : kCommandOptions) known += (known.empty() ? "" : ", ") + c;
+    throw UnknownCommand("unknown command '" + a.cmd + "' (commands: " + known + ")");
+  }
   for (int i = 2; i < argc; ++i) {
     std::string s = argv[i];
     if (s.rfind("--", 0) == 0) {
@@ -112,29 +153,102 @@ Args parse(int argc, char** argv) {
   return a;
 }
 
+/// Refuse unknown options, an option given twice (the first copy would win silently; only --effect
+/// adds up) and arguments beyond the DATASET the command takes.
 void checkOptions(const Args& a) {
   for (const auto& [k, v] : a.opts) refuseUnknownOption(a.cmd, k);
   for (const auto& k : a.flags) refuseUnknownOption(a.cmd, k);
+  for (auto it = a.opts.begin(); it != a.opts.end(); it = a.opts.upper_bound(it->first)) {
+    if (it->first == "effect" || a.opts.count(it->first) < 2) continue;
+    std::string values;
+    for (const auto& v : a.all(it->first)) values += (values.empty() ? "'" : ", '") + v + "'";
+    throw std::invalid_argument("--" + it->first + " is given " + std::to_string(a.opts.count(it->first)) +
+                                " times (" + values + "): give it once");
+  }
+  const std::size_t takes = a.cmd == "compare" || a.cmd == "diagnose" || a.cmd == "fit" ? 1 : 0;
+  if (a.positional.size() > takes)
+    throw std::invalid_argument("unexpected argument '" + a.positional[takes] + "' ('" + a.cmd + "' takes " +
+                                (takes ? "one DATASET" : "options only") + ")");
 }
 
 /// compare's report directory when --out is not given.
 const char* const kDefaultReportDir = "calibration_report";
 
-/// The command's output places exist and can be written (output_files.h), checked before its work;
-/// else an OutputError that names the option.
-void checkOutputs(const Args& a) {
-  auto check = [&](const std::string& option, bool directory, const std::string& path) {
-    try {
-      if (directory) makeOutputDirectory(path);
-      else checkOutputFile(path);
-    } catch (const OutputError& e) {
-      throw OutputError("--" + option + ": " + e.what());
+/// Folders the output checks created, removed again (if still empty) when the run ends in an error.
+std::vector<std::string> g_created_dirs;
+
+void removeCreatedDirs() {
+  for (auto it = g_created_dirs.rbegin(); it != g_created_dirs.rend(); ++it) ::rmdir(it->c_str());
+  g_created_dirs.clear();
+}
+
+/// The folders of `dir` (itself included) that do not exist, outermost first.
+std::vector<std::string> missingDirs(std::string dir) {
+  std::vector<std::string> out;
+  while (dir.size() > 1 && dir.back() == '/') dir.pop_back();
+  while (!dir.empty() && dir != "/" && ::access(dir.c_str(), F_OK) != 0) {
+    out.insert(out.begin(), dir);
+    const std::size_t slash = dir.find_last_of('/');
+    if (slash == std::string::npos) break;
+    dir = dir.substr(0, slash);
+  }
+  return out;
+}
+
+std::string parentOf(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
+}
+
+/// Creating a file is the only test that both the permission bits and special filesystems answer
+/// truly: root may "write" in /proc by access(2), yet cannot create a file there. An existing file
+/// is opened without truncation; a new one (or a probe in a folder) is removed again.
+void probeWrite(const std::string& path, bool directory) {
+  int fd = -1;
+  std::string created;
+  if (directory) {
+    std::string probe = path + "/.sbot_calibrate_probe_XXXXXX";
+    fd = ::mkstemp(&probe[0]);
+    if (fd >= 0) created = probe;
+  } else if (::access(path.c_str(), F_OK) == 0) {
+    fd = ::open(path.c_str(), O_WRONLY | O_NONBLOCK);
+  } else {
+    fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+    if (fd >= 0) created = path;
+  }
+  if (fd < 0) throw OutputError("cannot write " + std::string(directory ? "in directory '" : "'") + path + "': " + std::strerror(errno));
+  ::close(fd);
+  if (!created.empty()) ::unlink(created.c_str());
+}
+
+/// The output place `path` of `--option` (a folder, or a file) exists (folders created) and can be
+/// written (output_files.h, then probeWrite); else an OutputError that names the option, with the
+/// folders this check created removed again.
+void checkOutputPlace(const std::string& option, const std::string& path, bool directory) {
+  const std::vector<std::string> missing = missingDirs(directory ? path : parentOf(path));
+  try {
+    if (directory) makeOutputDirectory(path);
+    else checkOutputFile(path);
+    probeWrite(path, directory);
+  } catch (const OutputError& e) {
+    for (auto it = missing.rbegin(); it != missing.rend(); ++it) ::rmdir(it->c_str());
+    throw OutputError("--" + option + ": " + e.what());
+  }
+  g_created_dirs.insert(g_created_dirs.end(), missing.begin(), missing.end());
+}
+
+/// A folder with something in it (a dataset written there would overwrite and mix with its files).
+bool isNonEmptyDirectory(const std::string& path) {
+  DIR* d = ::opendir(path.c_str());
+  if (!d) return false;
+  bool empty = true;
+  while (const dirent* e = ::readdir(d))
+    if (std::strcmp(e->d_name, ".") && std::strcmp(e->d_name, "..")) {
+      empty = false;
+      break;
     }
-  };
-  if (a.cmd == "compare") check("out", true, a.get("out", kDefaultReportDir));
-  if (a.cmd == "generate" && a.has("out")) check("out", true, a.get("out"));
-  if ((a.cmd == "fit" || a.cmd == "sweep") && a.has("out")) check("out", false, a.get("out"));
-  if (a.cmd == "diagnose" && a.has("write-effects")) check("write-effects", false, a.get("write-effects"));
+  ::closedir(d);
+  return !empty;
 }
 
 std::string pct(double v) {
@@ -159,22 +273,31 @@ void usage() {
                "  compare/diagnose/fit: --solver quickstep|exact replaces the dataset's world stepper\n");
 }
 
+/// --solver (the world's stepper), checked.
+std::string solverOption(const Args& a, const std::string& def) {
+  const std::string s = a.get("solver", def);
+  if (s != "quickstep" && s != "exact") throw std::invalid_argument("--solver expects quickstep or exact, got '" + s + "'");
+  return s;
+}
+
 /// The dataset, with --solver replacing its world's stepper (quickstep | exact): whether a misfit is
 /// the model's physics or quickstep's non-convergence, without editing the dataset.
 Dataset datasetFor(const Args& a) {
   Dataset ds = loadDataset(a.positional[0]);
-  if (a.has("solver")) {
-    const std::string s = a.get("solver");
-    if (s != "quickstep" && s != "exact") throw std::invalid_argument("--solver expects quickstep or exact, got '" + s + "'");
-    ds.world.solver = s;
-  }
+  if (a.has("solver")) ds.world.solver = solverOption(a, "");
   return ds;
 }
 
+/// The effects file of --effects, checked against the dataset's surfaces too (effect_list.h).
+std::vector<EffectConfig> effectsOption(const Dataset& ds, const Args& a) {
+  return loadCheckedEffects(a.get("effects"), ds.obstacleSurfaces());
+}
+
+/// The model to start from: --level (default the dataset's) and the --effects file's effects.
 ModelSpec baseModel(const Dataset& ds, const Args& a) {
-  ModelSpec m{ds.robot, {}};
-  if (a.has("level")) m.level = a.get("level");
-  if (a.has("effects")) m.effects = loadEffectsConfig(a.get("effects"));
+  ModelSpec m{a.get("level", ds.robot), {}};
+  loadLevel(m.level);  // an unknown level is named now, not by the first replay
+  if (a.has("effects")) m.effects = effectsOption(ds, a);
   return m;
 }
 
@@ -193,21 +316,20 @@ int cmdEffects() {
 int cmdCompare(const Args& a) {
   if (a.positional.empty()) throw std::invalid_argument("compare needs a DATASET");
   const Dataset ds = datasetFor(a);
-  ModelSpec nominal{a.has("level") ? a.get("level") : ds.robot, {}};
+  const ModelSpec with_effects = baseModel(ds, a);
+  const ModelSpec nominal{with_effects.level, {}};
   std::vector<std::pair<std::string, ModelSpec>> variants{{"nominal", nominal}};
-  if (a.has("effects")) {
-    const auto effs = loadEffectsConfig(a.get("effects"));
-    // Waterfall: add the file's effects one by one.
-    ModelSpec m = nominal;
-    for (std::size_t i = 0; i < effs.size(); ++i) {
-      m.effects.push_back(effs[i]);
-      variants.push_back({"+" + effs[i].name, m});
-    }
+  // Waterfall: add the file's effects one by one.
+  ModelSpec m = nominal;
+  for (const auto& e : with_effects.effects) {
+    m.effects.push_back(e);
+    variants.push_back({"+" + e.name, m});
   }
   CompareOptions co;
   co.out_dir = a.get("out", kDefaultReportDir);
   co.plots = !a.has("no-plots");
   co.eval.replay.align = !a.has("no-align");
+  checkOutputPlace("out", co.out_dir, true);
   const auto sums = writeCompareReport(ds, variants, co, WorkerPool::global());
   std::printf("%-28s %-60s %10s\n", "model", "effects", "nRMS");
   for (const auto& s : sums) std::printf("%-28s %-60s %10.4f\n", s.label.c_str(), s.model.describe().c_str(), s.nrms);
@@ -218,20 +340,61 @@ int cmdCompare(const Args& a) {
   return 0;
 }
 
+/// Candidate effects named by --candidates, each once and each one the dataset can show.
+std::vector<std::string> namedCandidates(const Dataset& ds, const Args& a) {
+  std::vector<std::string> out;
+  for (const auto& n : splitList(a.get("candidates"), ',')) {
+    requireEffect(n, "--candidates");
+    if (std::find(out.begin(), out.end(), n) != out.end())
+      throw std::invalid_argument("--candidates names " + n + " twice");
+    for (const std::string& why : {unmeasuredChannels(ds, n), missingSurfaces(ds, n)})
+      if (!why.empty()) throw std::invalid_argument("--candidates: " + why + ": it cannot be screened");
+    out.push_back(n);
+  }
+  if (out.empty()) throw std::invalid_argument("--candidates names no effect");
+  return out;
+}
+
+/// Says which library effects the automatic candidate list leaves out, and why.
+void printSkippedCandidates(const Dataset& ds) {
+  const std::vector<std::string> cands = candidateEffects(ds);
+  std::map<std::string, std::string> by_channels;  // "ir, ground" -> "ir_incidence, ir_ambient"
+  for (const auto& n : EffectRegistry::instance().names()) {
+    if (std::find(cands.begin(), cands.end(), n) != cands.end()) continue;
+    if (const std::string why = missingSurfaces(ds, n); !why.empty() && unmeasuredChannels(ds, n).empty()) {
+      std::printf("note: not screened: %s\n", why.c_str());
+      continue;
+    }
+    std::string channels;
+    for (const auto& c : EffectRegistry::instance().info(n).channels) channels += (channels.empty() ? "" : ", ") + c;
+    by_channels[channels] += (by_channels[channels].empty() ? "" : ", ") + n;
+  }
+  if (by_channels.empty()) return;
+  std::string list;
+  for (const auto& [channels, effects] : by_channels) list += (list.empty() ? "" : "; ") + effects + " (" + channels + ")";
+  std::printf("note: not screened, the dataset measures none of the channels they act on: %s\n", list.c_str());
+}
+
 int cmdDiagnose(const Args& a) {
   if (a.positional.empty()) throw std::invalid_argument("diagnose needs a DATASET");
   const Dataset ds = datasetFor(a);
   DiagnoseOptions o;
   o.base = baseModel(ds, a);
-  o.folds = static_cast<int>(a.num("folds", 2));
+  o.folds = static_cast<int>(a.whole("folds", 2, 2, INT_MAX, "each fold's runs are scored by a fit on the others"));
   o.bic_threshold = a.num("threshold", 10);
-  o.seed = static_cast<std::uint64_t>(a.num("seed", 1));
-  if (a.has("candidates")) o.candidates = splitList(a.get("candidates"), ',');
+  o.seed = static_cast<std::uint64_t>(a.whole("seed", 1, 0, LLONG_MAX));
+  if (a.has("candidates")) o.candidates = namedCandidates(ds, a);
   o.progress = !a.has("quiet");
   if (a.has("verbose")) o.log = [](const std::string& s) { std::fprintf(stderr, "%s\n", s.c_str()); };
+  if (a.has("write-effects")) checkOutputPlace("write-effects", a.get("write-effects"), false);
   WorkerPool& pool = WorkerPool::global();
+  const int folds = foldCount(ds, o.folds);
   std::printf("diagnose %s: %zu runs, %zu samples, level %s, %d folds, %d worker processes\n", ds.name.c_str(), ds.runs.size(),
-              ds.sampleCount(), o.base.level.c_str(), o.folds, pool.size());
+              ds.sampleCount(), o.base.level.c_str(), folds, pool.size());
+  if (folds < o.folds)
+    std::printf("note: --folds %d, but a fold holds out whole runs and the dataset has %zu run%s: %d fold%s\n", o.folds,
+                ds.runs.size(), ds.runs.size() == 1 ? "" : "s", folds, folds == 1 ? " (scores in-sample)" : "s");
+  if (o.candidates.empty()) printSkippedCandidates(ds);
   const DiagnoseResult r = diagnose(ds, o, pool);
   for (std::size_t i = 0; i < r.rounds.size(); ++i) {
     const auto& rd = r.rounds[i];
@@ -252,40 +415,55 @@ int cmdDiagnose(const Args& a) {
   }
   std::printf("\n%s", r.verdict.c_str());
   std::printf("diagnose took %.1f s wall, %d run simulations, %d worker processes\n", r.seconds, r.simulations, pool.size());
-  if (a.has("write-effects") && !r.accepted.empty()) {
+  if (a.has("write-effects")) {
+    // Also with nothing accepted: the file then holds the model diagnose ends with (the nominal one,
+    // or --effects' base), so that the next step (compare --effects FILE) works either way.
     std::vector<EffectConfig> cfg = r.final_model.effects;
     for (auto& c : cfg)
       for (std::size_t j = 0; j < r.final_fit.free.size(); ++j)
         if (r.final_fit.model.effects[r.final_fit.free[j].effect].name == c.name)
           c.stderr_[r.final_fit.free[j].name] = r.final_fit.stderr_[j];
     writeEffectsFile(a.get("write-effects"), cfg, "accepted by sbot_calibrate diagnose " + ds.yaml_path);
-    std::printf("effects written to %s\n", a.get("write-effects").c_str());
+    if (!r.accepted.empty()) std::printf("effects written to %s\n", a.get("write-effects").c_str());
+    else if (cfg.empty()) std::printf("no effect accepted: %s written with no effects (the nominal model)\n", a.get("write-effects").c_str());
+    else std::printf("no effect accepted: %s written with the --effects base model only\n", a.get("write-effects").c_str());
   }
   return 0;
 }
 
 int cmdFit(const Args& a) {
   if (a.positional.empty()) throw std::invalid_argument("fit needs a DATASET");
-  const auto names = a.all("effect");
+  std::vector<std::string> names;
+  for (const auto& given : a.all("effect"))
+    for (const auto& n : splitList(given, ',')) {
+      requireEffect(n, "--effect");
+      if (std::find(names.begin(), names.end(), n) != names.end())
+        throw std::invalid_argument("--effect " + n + " is given twice");
+      names.push_back(n);
+    }
   if (names.empty()) throw std::invalid_argument("fit needs --effect NAME");
   if (!a.has("out")) throw std::invalid_argument("fit needs --out FILE (the effects file to write)");
   const Dataset ds = datasetFor(a);
   ModelSpec m = baseModel(ds, a);
   std::vector<int> idx;
-  for (const auto& n0 : names)
-    for (const auto& n : splitList(n0, ',')) {
-      EffectRegistry::instance().info(n);  // throws on unknown
-      bool found = false;
-      for (std::size_t i = 0; i < m.effects.size(); ++i)
-        if (m.effects[i].name == n) {
-          idx.push_back(static_cast<int>(i));
-          found = true;
-        }
-      if (!found) {
-        m.effects.push_back({n, {}, {}, ""});
-        idx.push_back(static_cast<int>(m.effects.size()) - 1);
-      }
+  for (const auto& n : names) {
+    if (const std::string why = unmeasuredChannels(ds, n); !why.empty())
+      throw std::invalid_argument("--effect: " + why + ": there is nothing to fit it to");
+    int at = -1;
+    for (std::size_t i = 0; i < m.effects.size(); ++i)
+      if (m.effects[i].name == n) at = static_cast<int>(i);
+    if (at < 0) {
+      // As diagnose does: per-surface parameters for the surfaces of the dataset's obstacles.
+      m.effects.push_back(EffectRegistry::instance().info(n).open_params ? candidateConfig(ds, n) : EffectConfig{n, {}, {}, ""});
+      at = static_cast<int>(m.effects.size()) - 1;
     }
+    if (freeParamsOf(m, {at}).empty())
+      throw std::invalid_argument("--effect: " + n + " has one parameter per surface, and neither the dataset's obstacles "
+                                  "nor an --effects file name a surface: list those to fit in an --effects BASE file, e.g. "
+                                  "effects: [{name: " + n + ", params: {white_paper: 1, black_card: 1}}]");
+    idx.push_back(at);
+  }
+  checkOutputPlace("out", a.get("out"), false);
   FitOptions fo;
   WorkerPool& pool = WorkerPool::global();
   std::size_t evals = 0;
@@ -319,21 +497,29 @@ int cmdGenerate(const Args& a) {
   if (!a.has("out")) throw std::invalid_argument("generate needs --out DIR");
   GeneratorOptions g;
   g.level = a.get("level", "simple");
-  g.solver = a.get("solver", "quickstep");
-  g.seed = static_cast<std::uint64_t>(a.num("seed", 1));
+  g.solver = solverOption(a, "quickstep");
+  g.seed = static_cast<std::uint64_t>(a.whole("seed", 1, 0, LLONG_MAX));
   g.duration = a.num("duration", 8);
   g.tilt_deg = a.num("tilt", 0);
-  g.repeat = static_cast<int>(a.num("repeat", 1));
-  g.max_runs = static_cast<std::size_t>(a.num("max-runs", 0));
+  g.repeat = static_cast<int>(a.whole("repeat", 1, 1, INT_MAX));
+  g.max_runs = static_cast<std::size_t>(a.whole("max-runs", 0, 0, INT_MAX, "0: all"));
   g.name = a.get("name", "synthetic");
   g.measure_torque = a.has("torque");
   g.measure_tilt = !a.has("no-tilt");
   g.measure_speed = !a.has("no-speed");
   if (a.has("families"))
     for (const auto& f : splitList(a.get("families"), ',')) g.experiments.insert(f);
-  if (a.has("hidden")) g.hidden = loadEffectsConfig(a.get("hidden"));
+  loadLevel(g.level);
+  checkGeneratorOptions(g);
+  if (a.has("hidden")) g.hidden = loadCheckedEffects(a.get("hidden"));
   if (a.has("hide"))
     for (const auto& e : parseEffectList(a.get("hide"), "--hide")) g.hidden.push_back(e);
+  // A dataset folder may hold real measurements: writing into it would overwrite its dataset.yaml
+  // and leave its other runs' files beside the new ones.
+  if (isNonEmptyDirectory(a.get("out")))
+    throw std::invalid_argument("--out " + a.get("out") + " is a folder that is not empty (a dataset written there would " +
+                                "overwrite its files and mix with the rest): remove it or choose another folder");
+  checkOutputPlace("out", a.get("out"), true);
   const Dataset ds = generateDataset(g, WorkerPool::global());
   writeDataset(ds, a.get("out"));
   std::printf("wrote %s: %zu runs, %zu samples (level %s, seed %llu)\n", a.get("out").c_str(), ds.runs.size(),
@@ -346,22 +532,25 @@ int cmdGenerate(const Args& a) {
 int main(int argc, char** argv) {
   try {
     const Args a = parse(argc, argv);
-    if (a.cmd.empty() || a.cmd == "--help" || a.cmd == "help" || a.has("help")) {
+    if (a.cmd.empty() || isHelp(a.cmd) || a.has("help")) {
       usage();
       return a.cmd.empty() ? 2 : 0;
     }
     checkOptions(a);
-    checkOutputs(a);
-    if (a.has("jobs")) WorkerPool::setGlobalSize(static_cast<int>(a.num("jobs", 0)));
+    if (a.has("jobs")) WorkerPool::setGlobalSize(static_cast<int>(a.whole("jobs", 0, 1, INT_MAX, "worker processes")));
     if (a.cmd == "effects") return cmdEffects();
     if (a.cmd == "compare") return cmdCompare(a);
     if (a.cmd == "diagnose") return cmdDiagnose(a);
     if (a.cmd == "fit") return cmdFit(a);
     if (a.cmd == "generate") return cmdGenerate(a);
-    if (a.cmd == "sweep") return runSweepCommand(a.opts, a.flags);
+    if (a.has("out")) checkOutputPlace("out", a.get("out"), false);  // sweep
+    return runSweepCommand(a.opts, a.flags);
+  } catch (const UnknownCommand& e) {
+    std::fprintf(stderr, "sbot_calibrate: %s\n", e.what());
     usage();
     return 2;
   } catch (const std::exception& e) {
+    removeCreatedDirs();  // a refused or failed run leaves no empty folder behind
     std::fprintf(stderr, "sbot_calibrate: %s\n", e.what());
     return 1;
   }

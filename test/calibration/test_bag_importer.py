@@ -3,7 +3,9 @@
 an overhead tracker as geometry_msgs/PoseStamped), imported back with bag_to_dataset.py and loaded by
 sbot_calibrate; commands and measurements must survive the trip. Usage: test_bag_importer.py SBOT_CALIBRATE
 """
+import contextlib
 import csv
+import io
 import math
 import os
 import shutil
@@ -166,6 +168,34 @@ class BagImporterTest(unittest.TestCase):
             bag_to_dataset.main([os.path.join(plain, "dataset"), good, "--tracker-topic", "/tracker/sbot_0"])
         self.assertIn("cannot create the dataset directory %s" % os.path.join(plain, "dataset"), str(e.exception))
         self.assertIn("Not a directory", str(e.exception))
+
+    def test_a_world_file_that_cannot_be_read_is_named(self):
+        good = os.path.join(self.tmp, "good_for_world.bag")
+        self.write_bag("straight_20", good)
+        out = os.path.join(self.tmp, "no_world")
+        missing = os.path.join(self.tmp, "no_such_world.yaml")
+        with self.assertRaises(SystemExit) as e:
+            bag_to_dataset.main([out, good, "--world", missing, "--tracker-topic", "/tracker/sbot_0"])
+        self.assertIn("--world: cannot read %s: No such file or directory" % missing, str(e.exception))
+        listed = os.path.join(self.tmp, "list_world.yaml")
+        with open(listed, "w") as f:
+            f.write("- plane\n")
+        with self.assertRaises(SystemExit) as e:
+            bag_to_dataset.main([out, good, "--world", listed, "--tracker-topic", "/tracker/sbot_0"])
+        self.assertIn("--world %s: expected the dataset's world mapping" % listed, str(e.exception))
+        self.assertFalse(os.path.exists(out))
+
+    def test_an_unknown_level_is_refused(self):
+        good = os.path.join(self.tmp, "good_for_level.bag")
+        self.write_bag("straight_20", good)
+        out = os.path.join(self.tmp, "bogus_level")
+        err = io.StringIO()
+        with self.assertRaises(SystemExit) as e, contextlib.redirect_stderr(err):
+            bag_to_dataset.main([out, good, "--level", "bogus", "--tracker-topic", "/tracker/sbot_0"])
+        self.assertNotEqual(e.exception.code, 0)
+        self.assertIn("invalid choice: 'bogus'", err.getvalue())
+        self.assertIn("medium", err.getvalue(), "lists the levels")
+        self.assertFalse(os.path.exists(out))
 
 
 if __name__ == "__main__":

@@ -19,6 +19,29 @@ using Outcome = sbot_test::ProcessOutcome;
 Outcome run(const std::string& args) { return sbot_test::runProcess(std::string(SBOT_CALIBRATE_BIN) + " " + args); }
 
 const std::string kExample = std::string(SWARMBOT3D_SOURCE_DIR) + "/datasets/example";
+/// One place run of 4 samples (IR only, one white_paper wall): fits and diagnoses in well under a second.
+const std::string kIrPoints = std::string(SWARMBOT3D_SOURCE_DIR) + "/datasets/seed_ir_response";
+
+/// An empty folder TempDir()/name/ (returned with the slash).
+std::string freshDir(const std::string& name) {
+  const std::string dir = testing::TempDir() + name + "/";
+  std::system(("rm -rf '" + dir + "' && mkdir -p '" + dir + "'").c_str());
+  return dir;
+}
+
+void writeFile(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+bool exists(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 TEST(Cli, AnOptionTheSubcommandDoesNotTakeIsRefusedByName) {
   const Outcome o = run("compare " + kExample + " --effect fitted.yaml --no-plots --out " + testing::TempDir() + "cli_typo");
@@ -76,6 +99,165 @@ TEST(Cli, TheOutputFolderIsNotShellTextAndUndrawnPlotsAreNotLinked) {
   const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
   EXPECT_EQ(text.find(".png"), std::string::npos) << "links a plot --no-plots did not draw";
   EXPECT_NE(::stat((out + "/plots/parity.png").c_str(), &st), 0) << "the earlier run's plot is still there";
+}
+
+// fit --effect ir_reflectance used to run 0 iterations on no parameter and write `params: {}`: its
+// parameters are per surface. They now come from the dataset's obstacles (as in diagnose); without
+// any, the refusal says how to name the surfaces.
+TEST(Cli, APerSurfaceEffectIsFittedOnTheDatasetsSurfacesOrRefused) {
+  const std::string dir = freshDir("cli_surfaces");
+  const Outcome o = run("fit " + kIrPoints + " --effect ir_reflectance --quiet --out " + dir + "refl.yaml");
+  EXPECT_EQ(o.status, 0) << o.output;
+  EXPECT_TRUE(contains(o.output, "ir_reflectance.white_paper = ")) << o.output;
+  EXPECT_TRUE(contains(readFile(dir + "refl.yaml"), "params: {white_paper: ")) << readFile(dir + "refl.yaml");
+
+  std::system(("cp " + kIrPoints + "/ir2_head_on.csv " + dir).c_str());
+  writeFile(dir + "dataset.yaml",
+            "format: sbot-dataset/1\nname: no_walls\nrobot: medium\nworld: {terrain: {type: plane}}\n"
+            "runs:\n  - {name: ir2_head_on, file: ir2_head_on.csv, kind: place}\n");
+  const Outcome none = run("fit " + dir + " --effect ir_reflectance --quiet --out " + dir + "none.yaml");
+  EXPECT_EQ(none.status, 1) << none.output;
+  EXPECT_TRUE(contains(none.output, "--effect: ir_reflectance has one parameter per surface")) << none.output;
+  EXPECT_TRUE(contains(none.output, "an --effects BASE file")) << "says how to give them: " << none.output;
+  EXPECT_FALSE(exists(dir + "none.yaml"));
+}
+
+// An effect on channels the dataset does not measure used to be "fitted" (exponent = 0 +- 1e+06)
+// or screened without a word.
+TEST(Cli, AnEffectOnChannelsTheDatasetDoesNotMeasureIsRefusedOrNoted) {
+  const std::string dir = freshDir("cli_channels");
+  const Outcome fit = run("fit " + kExample + " --effect ir_incidence --quiet --out " + dir + "f.yaml");
+  EXPECT_EQ(fit.status, 1) << fit.output;
+  EXPECT_TRUE(contains(fit.output, "--effect: ir_incidence acts on ir, which dataset 'example' does not measure (it measures "))
+      << fit.output;
+  const Outcome named = run("diagnose " + kIrPoints + " --quiet --candidates ir_ambient,latency");
+  EXPECT_EQ(named.status, 1) << named.output;
+  EXPECT_TRUE(contains(named.output, "--candidates: latency acts on pose, speed, none of which dataset 'seed_ir_response' measures"))
+      << named.output;
+  const Outcome automatic = run("diagnose " + kIrPoints + " --quiet");
+  EXPECT_EQ(automatic.status, 0) << automatic.output;
+  EXPECT_TRUE(contains(automatic.output, "note: not screened, the dataset measures none of the channels they act on: "))
+      << automatic.output;
+  EXPECT_TRUE(contains(automatic.output, "light_angular, light_ambient (light)")) << automatic.output;
+}
+
+TEST(Cli, OptionValuesOutsideTheirRangeAndStrayArgumentsAreRefusedByName) {
+  const std::string dir = freshDir("cli_values");
+  auto refused = [](const std::string& args, const std::string& message) {
+    const Outcome o = run(args);
+    EXPECT_EQ(o.status, 1) << args << ": " << o.output;
+    EXPECT_TRUE(contains(o.output, "sbot_calibrate: " + message)) << args << ": " << o.output;
+  };
+  for (const char* folds : {"0", "1", "-2", "2.5"})
+    refused("diagnose " + kIrPoints + " --quiet --folds " + folds,
+            "--folds expects a whole number of at least 2 (each fold's runs are scored by a fit on the others), got '" +
+                std::string(folds) + "'");
+  for (const char* t : {"nan", "inf"})
+    refused("diagnose " + kIrPoints + " --quiet --threshold " + t, "--threshold expects a finite number, got '" + std::string(t) + "'");
+  for (const char* jobs : {"0", "-1"})
+    refused("effects --jobs " + std::string(jobs), "--jobs expects a whole number of at least 1 (worker processes), got '" + std::string(jobs) + "'");
+  refused("compare " + kIrPoints + " " + kIrPoints + " --no-plots --out " + dir + "r",
+          "unexpected argument '" + kIrPoints + "' ('compare' takes one DATASET)");
+  refused("fit " + kIrPoints + " --effect ir_reflectance --effect ir_reflectance --out " + dir + "f.yaml",
+          "--effect ir_reflectance is given twice");
+  refused("fit " + kIrPoints + " --effect ir_reflectance --out " + dir + "a.yaml --out " + dir + "b.yaml",
+          "--out is given 2 times");
+  refused("fit " + kIrPoints + " --effect nonsuch --out " + dir + "f.yaml",
+          "--effect: unknown effect 'nonsuch' (known: latency, dead_band, ");
+  const Outcome unknown = run("calibrate " + kIrPoints);
+  EXPECT_EQ(unknown.status, 2) << unknown.output;
+  EXPECT_TRUE(contains(unknown.output, "sbot_calibrate: unknown command 'calibrate' (commands: compare, diagnose, ")) << unknown.output;
+  EXPECT_TRUE(contains(unknown.output, "usage: ")) << unknown.output;
+  // More folds than runs: the folds it uses are announced, not those asked for.
+  const Outcome few = run("diagnose " + kIrPoints + " --quiet --folds 3");
+  EXPECT_EQ(few.status, 0) << few.output;
+  EXPECT_TRUE(contains(few.output, "level medium, 1 folds,")) << few.output;
+  EXPECT_TRUE(contains(few.output, "note: --folds 3, but a fold holds out whole runs and the dataset has 1 run: 1 fold (scores in-sample)"))
+      << few.output;
+}
+
+// diagnose --write-effects wrote nothing when nothing was accepted, so `compare --effects FILE`,
+// the next step, failed on a missing file.
+TEST(Cli, DiagnoseWritesTheNominalModelWhenNothingIsAccepted) {
+  const std::string dir = freshDir("cli_none_accepted");
+  const Outcome d = run("diagnose " + kIrPoints + " --quiet --write-effects " + dir + "effects.yaml");
+  EXPECT_EQ(d.status, 0) << d.output;
+  EXPECT_TRUE(contains(d.output, "no effect accepted: " + dir + "effects.yaml written with no effects (the nominal model)")) << d.output;
+  EXPECT_TRUE(contains(readFile(dir + "effects.yaml"), "effects: []")) << readFile(dir + "effects.yaml");
+  const Outcome c = run("compare " + kIrPoints + " --quiet --no-plots --effects " + dir + "effects.yaml --out " + dir + "report");
+  EXPECT_EQ(c.status, 0) << c.output;
+}
+
+// generate overwrote a folder's dataset.yaml and left its other CSV files beside the new runs, and
+// took families, durations, seeds and tilts it cannot make.
+TEST(Cli, GenerateRefusesAFolderInUseAndValuesItCannotMake) {
+  const std::string dir = freshDir("cli_generate");
+  std::system(("mkdir -p " + dir + "lab && echo 't,x' > " + dir + "lab/measured.csv").c_str());
+  const std::string quick = " --families straight --duration 2 --jobs 2 --quiet";
+  const Outcome used = run("generate --out " + dir + "lab" + quick);
+  EXPECT_EQ(used.status, 1) << used.output;
+  EXPECT_TRUE(contains(used.output, "sbot_calibrate: --out " + dir + "lab is a folder that is not empty")) << used.output;
+  EXPECT_TRUE(contains(used.output, "remove it or choose another folder")) << used.output;
+  EXPECT_FALSE(exists(dir + "lab/dataset.yaml"));
+
+  const std::string out = " --out " + dir + "new/data";
+  auto refused = [&](const std::string& args, const std::string& message) {
+    const Outcome o = run("generate" + out + " --jobs 2 --quiet " + args);
+    EXPECT_EQ(o.status, 1) << args << ": " << o.output;
+    EXPECT_TRUE(contains(o.output, "sbot_calibrate: " + message)) << args << ": " << o.output;
+    EXPECT_FALSE(exists(dir + "new")) << args << ": a refused run created its output folder";
+  };
+  refused("--families straight,warp", "--families: unknown family 'warp' (known: straight, spin, arc, square, steps, place, approach)");
+  for (const char* d : {"0", "0.001", "-3", "1.9"})
+    refused(std::string("--families straight --duration ") + d, "--duration expects 2 to 3600 s");
+  refused("--duration nan", "--duration expects a finite number, got 'nan'");
+  refused("--hide speed_scale:scale=", "--hide 'speed_scale:scale=': speed_scale.scale expects a finite number, got ''");
+  refused("--seed -5", "--seed expects a whole number from 0 to 9223372036854775807, got '-5'");
+  refused("--seed 99999999999999999999", "--seed expects a whole number from 0 to 9223372036854775807");
+  refused("--tilt 95", "--tilt expects a floor tilt from 0 to 30 deg");
+  refused("--families place --level simple",
+          "--families place needs a level with ray-traced IR (basic, medium, detailed); level 'simple'");
+  refused("--level bogus", "unknown model level 'bogus'");
+}
+
+// fit and diagnose checked their output file only by access(2), which root passes in /proc: the
+// work ran and its result was lost. A refused run also left the folders the check had created.
+TEST(Cli, FitAndDiagnoseOutputsAreTriedBeforeTheWorkAndARefusedRunCreatesNoFolder) {
+  const std::string dir = freshDir("cli_out_first");
+  const Outcome fit = run("fit " + kIrPoints + " --effect ir_reflectance --quiet --out /proc/sbot_fitted.yaml");
+  EXPECT_EQ(fit.status, 1) << fit.output;
+  EXPECT_TRUE(contains(fit.output, "sbot_calibrate: --out: cannot write '/proc/sbot_fitted.yaml': ")) << fit.output;
+  EXPECT_FALSE(contains(fit.output, "normalised RMS")) << "nothing was fitted: " << fit.output;
+  const Outcome diag = run("diagnose " + kIrPoints + " --quiet --write-effects /proc/sbot_diagnosed.yaml");
+  EXPECT_EQ(diag.status, 1) << diag.output;
+  EXPECT_TRUE(contains(diag.output, "sbot_calibrate: --write-effects: cannot write '/proc/sbot_diagnosed.yaml': ")) << diag.output;
+  EXPECT_FALSE(contains(diag.output, "VERDICT")) << "nothing was diagnosed: " << diag.output;
+
+  const Outcome bad_base = run("fit " + kIrPoints + " --effect ir_reflectance --effects " + dir + "no_such.yaml --out " + dir +
+                               "made/by/check/f.yaml");
+  EXPECT_EQ(bad_base.status, 1) << bad_base.output;
+  EXPECT_FALSE(exists(dir + "made")) << "the refused run created the folders of its --out";
+  const Outcome bad_diag = run("diagnose " + kIrPoints + " --folds 0 --write-effects " + dir + "made/e.yaml");
+  EXPECT_EQ(bad_diag.status, 1) << bad_diag.output;
+  EXPECT_FALSE(exists(dir + "made")) << "the refused run created the folder of its --write-effects";
+}
+
+// The effects library's loader took a stderr key that is no parameter and a surface no dataset can
+// have: both would be dropped without a word.
+TEST(Cli, AnEffectsFileWithAnUnknownSurfaceOrStderrKeyIsRefused) {
+  const std::string dir = freshDir("cli_effects_file");
+  writeFile(dir + "surface.yaml", "format: sbot-effects/1\neffects:\n  - name: ir_reflectance\n    params: {green_cheese: 0.5}\n");
+  writeFile(dir + "stderr.yaml",
+            "format: sbot-effects/1\neffects:\n  - name: latency\n    params: {delay: 0.1}\n    stderr: {dely: 0.01}\n");
+  const Outcome surface = run("compare " + kIrPoints + " --quiet --no-plots --effects " + dir + "surface.yaml --out " + dir + "r1");
+  EXPECT_EQ(surface.status, 1) << surface.output;
+  EXPECT_TRUE(contains(surface.output, dir + "surface.yaml: field 'effects[0].params.green_cheese': ir_reflectance: unknown surface "
+                                           "'green_cheese' (known: aluminium, black_card,"))
+      << surface.output;
+  const Outcome err = run("compare " + kIrPoints + " --quiet --no-plots --effects " + dir + "stderr.yaml --out " + dir + "r2");
+  EXPECT_EQ(err.status, 1) << err.output;
+  EXPECT_TRUE(contains(err.output, dir + "stderr.yaml: field 'effects[0].stderr.dely': 'dely' is not a parameter of latency (it has: delay)"))
+      << err.output;
 }
 
 TEST(Cli, TheOptionsItTakesAreAccepted) {
