@@ -59,6 +59,11 @@ TEST(EffectsFile, ErrorsNameTheField) {
   EXPECT_EQ(fieldOf("effect: []"), "effect");
   EXPECT_EQ(fieldOf("format: sbot-effects/9\neffects: []"), "format");
   EXPECT_EQ(fieldOf("effects: [{name: latency"), "") << "YAML syntax errors name the file";
+  EXPECT_EQ(fieldOf("effects: [{name: [latency]}]"), "effects[0].name");
+  EXPECT_EQ(fieldOf("effects: [{name: latency, params: {delay: 0.1}, stderr: {dleay: 0.01}}]"), "effects[0].stderr.dleay")
+      << "a standard error for a value the file does not give";
+  EXPECT_EQ(fieldOf("effects: [{name: latency, params: {delay: 0.1}}, {name: latency, delay: 1}]"), "effects[1].delay");
+  EXPECT_EQ(fieldOf("effects:\n  - name: latency\n    name: speed_scale\n"), "") << "a repeated key names the file";
   EXPECT_THROW(loadEffectsFile("/nonexistent/effects.yaml"), ConfigError);
 }
 

@@ -77,11 +77,15 @@ std::vector<EffectConfig> parseEffectsConfig(const std::string& yaml_text, const
       if (k != "name" && k != "params" && k != "stderr" && k != "note" && k != "ci95")
         throw ConfigError(src, field + "." + k, "unknown field (expected name, params, stderr, ci95, note)" + at(kv.first));
     }
-    if (!e["name"] || !e["name"].IsScalar()) throw ConfigError(src, field + ".name", "missing effect name" + at(e));
+    if (!e["name"]) throw ConfigError(src, field + ".name", "missing effect name" + at(e));
+    if (!e["name"].IsScalar()) throw ConfigError(src, field + ".name", "must be one effect's name" + at(e["name"]));
     EffectConfig c;
     c.name = e["name"].as<std::string>();
     c.params = numberMap(e["params"], field + ".params", src);
     c.stderr_ = numberMap(e["stderr"], field + ".stderr", src);
+    for (const auto& [k, v] : c.stderr_)  // an uncertainty of a value the file does not give
+      if (!c.params.count(k))
+        throw ConfigError(src, field + ".stderr." + k, "a standard error for '" + k + "', which params does not give");
     if (e["note"]) c.note = e["note"].as<std::string>();
     if (!seen.insert(c.name).second) throw ConfigError(src, field + ".name", "effect '" + c.name + "' listed twice");
     reg.create(c.name, c.params, src, field);  // validates name, parameter names and bounds
