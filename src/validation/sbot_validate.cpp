@@ -592,9 +592,10 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
   };
   const bool tallied = !t.group.empty(), levels = t.severalLevels(), speeds = t.otherSpeeds();
   // Rows must not differ only in what the table does not show: cells' variants without a
-  // variant_header, and floors of their own (track_mu), get a column too.
-  const bool variants = !t.variant_header.empty() ||
-                        std::any_of(t.cells.begin(), t.cells.end(), [](const v::ReferenceCell& c) { return !c.variant.empty(); });
+  // variant_header, and floors of their own (track_mu), get a column when they differ.
+  const bool variants = !t.variant_header.empty() || std::any_of(t.cells.begin(), t.cells.end(), [&](const v::ReferenceCell& c) {
+                          return c.variant != t.cells.front().variant;
+                        });
   const bool floors = std::any_of(t.cells.begin(), t.cells.end(),
                                   [&](const v::ReferenceCell& c) { return c.track_mu != t.cells.front().track_mu; });
   md << "## " << t.title << " (modal of " << o.trials << ")\n\n";
