@@ -79,20 +79,7 @@ void checkEffectConfigs(const std::vector<EffectConfig>& configs, const std::str
                               "; a dataset declares others under 'surfaces:' and uses them on its obstacles)");
       }
     }
-    // A stderr belongs to a parameter: of the library's for the effect, or (per-surface ones) of the file's.
-    std::vector<std::string> params;
-    if (info.open_params)
-      for (const auto& [p, v] : c.params) params.push_back(p);
-    else
-      for (const auto& p : info.params) params.push_back(p.name);
-    for (const auto& [k, v] : c.stderr_) {
-      if (std::find(params.begin(), params.end(), k) != params.end()) continue;
-      std::string list;
-      for (const auto& p : params) list += (list.empty() ? "" : ", ") + p;
-      throw ConfigError(source, field + ".stderr." + k,
-                        "'" + k + "' is not a parameter of " + c.name + " (" + (info.open_params ? "the file sets: " : "it has: ") +
-                            (list.empty() ? "none" : list) + ")");
-    }
+    // (A stderr for a value params does not give is refused by the core's loader.)
   }
 }
 

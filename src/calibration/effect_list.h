@@ -23,8 +23,7 @@ void requireEffect(const std::string& name, const std::string& option);
 std::vector<EffectConfig> parseEffectList(const std::string& spec, const std::string& source);
 
 /// What the effects library's loader leaves unchecked (ConfigError naming `source` and the field):
-/// a `stderr` key that is not a parameter of the effect (a misspelt one would be dropped), and a
-/// per-surface parameter (ir_reflectance) whose surface label is neither known (knownSurfaces) nor
+/// a per-surface parameter (ir_reflectance) whose surface label is neither known (knownSurfaces) nor
 /// in `surfaces` (e.g. a dataset's obstacle labels): it would never act.
 void checkEffectConfigs(const std::vector<EffectConfig>& configs, const std::string& source,
                         const std::set<std::string>& surfaces = {});

@@ -256,7 +256,7 @@ TEST(Cli, AnEffectsFileWithAnUnknownSurfaceOrStderrKeyIsRefused) {
       << surface.output;
   const Outcome err = run("compare " + kIrPoints + " --quiet --no-plots --effects " + dir + "stderr.yaml --out " + dir + "r2");
   EXPECT_EQ(err.status, 1) << err.output;
-  EXPECT_TRUE(contains(err.output, dir + "stderr.yaml: field 'effects[0].stderr.dely': 'dely' is not a parameter of latency (it has: delay)"))
+  EXPECT_TRUE(contains(err.output, dir + "stderr.yaml: field 'effects[0].stderr.dely': a standard error for 'dely', which params does not give (params: delay)"))
       << err.output;
 }
 

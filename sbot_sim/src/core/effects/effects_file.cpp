@@ -83,9 +83,14 @@ std::vector<EffectConfig> parseEffectsConfig(const std::string& yaml_text, const
     c.name = e["name"].as<std::string>();
     c.params = numberMap(e["params"], field + ".params", src);
     c.stderr_ = numberMap(e["stderr"], field + ".stderr", src);
-    for (const auto& [k, v] : c.stderr_)  // an uncertainty of a value the file does not give
-      if (!c.params.count(k))
-        throw ConfigError(src, field + ".stderr." + k, "a standard error for '" + k + "', which params does not give");
+    for (const auto& [k, v] : c.stderr_) {  // an uncertainty of a value the file does not give
+      if (c.params.count(k)) continue;
+      std::string given;
+      for (const auto& [p, x] : c.params) given += (given.empty() ? "" : ", ") + p;
+      throw ConfigError(src, field + ".stderr." + k,
+                        "a standard error for '" + k + "', which params does not give (params: " +
+                            (given.empty() ? "none" : given) + ")");
+    }
     if (e["note"]) c.note = e["note"].as<std::string>();
     if (!seen.insert(c.name).second) throw ConfigError(src, field + ".name", "effect '" + c.name + "' listed twice");
     reg.create(c.name, c.params, src, field);  // validates name, parameter names and bounds
