@@ -23,6 +23,18 @@ bool ReferenceTable::severalLevels() const {
   return false;
 }
 
+bool ReferenceTable::severalVariants() const {
+  for (const ReferenceCell& c : cells)
+    if (c.variant != cells.front().variant) return true;
+  return false;
+}
+
+bool ReferenceTable::severalFloors() const {
+  for (const ReferenceCell& c : cells)
+    if (c.track_mu != cells.front().track_mu) return true;
+  return false;
+}
+
 bool ReferenceTable::otherSpeeds() const {
   for (const ReferenceCell& c : cells)
     if (c.speed_units != kSlowUnits) return true;

@@ -64,6 +64,9 @@ struct ReferenceTable {
   bool severalLevels() const;
   /// Whether a cell drives at other than the seed's 2.8 cm/s (the report then has a speed column).
   bool otherSpeeds() const;
+  /// Whether the cells' variants, or their treels' mu, differ (the report then shows them).
+  bool severalVariants() const;
+  bool severalFloors() const;
   /// The parameter as shown ("15 mm").
   std::string paramText(const ReferenceCell& c) const;
   /// The cell's name in the report and in the mismatch reasons: "<id> <param> [<variant>] [<level>]"

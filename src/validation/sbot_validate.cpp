@@ -126,11 +126,11 @@ struct Tally {
 /// The report's reasons for the cells that do not match (mismatch_reasons.h).
 v::MismatchReasons reasons;
 
-/// The cells the built-in section 4.1pair names (its rows are not cells of a tables file).
 /// Cells with a trial that could not run (an exception or a crashed worker, said on stderr): they
 /// are not mismatches of the model, and the exit status says so.
 std::vector<std::string> g_error_cells;
 
+/// The cells the built-in section 4.1pair names (its rows are not cells of a tables file).
 const char* const kPairFullKey = "4.1 pair limit of full manoeuvrability";
 const char* const kPairStableKey = "4.1 pair limit of stable position";
 const char* const kPairStepSingleKey = "4.1.3 32 mm single s-bot";
@@ -593,11 +593,7 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
   const bool tallied = !t.group.empty(), levels = t.severalLevels(), speeds = t.otherSpeeds();
   // Rows must not differ only in what the table does not show: cells' variants without a
   // variant_header, and floors of their own (track_mu), get a column when they differ.
-  const bool variants = !t.variant_header.empty() || std::any_of(t.cells.begin(), t.cells.end(), [&](const v::ReferenceCell& c) {
-                          return c.variant != t.cells.front().variant;
-                        });
-  const bool floors = std::any_of(t.cells.begin(), t.cells.end(),
-                                  [&](const v::ReferenceCell& c) { return c.track_mu != t.cells.front().track_mu; });
+  const bool variants = !t.variant_header.empty() || t.severalVariants(), floors = t.severalFloors();
   md << "## " << t.title << " (modal of " << o.trials << ")\n\n";
   if (!t.about.empty()) md << t.about << "\n\n";
   if (std::any_of(t.cells.begin(), t.cells.end(), [](const v::ReferenceCell& c) { return c.level == "fast"; }) &&
