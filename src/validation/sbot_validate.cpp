@@ -92,6 +92,8 @@ constexpr int kRtmRepeats = 5;  ///< Table 4.4: runs per RTM figure, the fastest
 const std::vector<std::string> kSections{"facts", "4.1pair", "4.4", "compat", "fig4.4"};
 const std::vector<std::string> kParagraphs{"backward_step_statics"};
 const char* kHardwareGroup = "hardware";
+/// The report so far, in --out beside report.md, while a run goes on or after it stopped part-way.
+const char* kPartialReportFile = "report.partial.md";
 
 std::string fmt(double v, int prec = 2) {
   std::ostringstream s;
@@ -143,12 +145,22 @@ std::string mark(const std::string& key, bool ok, Tally& t) {
   return reasons.record(key, ok);
 }
 
+/// A cell whose modal label is "error" (its trials could not run) is counted as not matching but is
+/// no model mismatch: marked so, it is listed in the summary (g_error_cells), not among the
+/// mismatches to explain.
+std::string markRun(const std::string& key, bool ok, bool ran, Tally& t) {
+  if (ran) return mark(key, ok, t);
+  ++t.total;
+  return "**error** (could not run)";
+}
+
 /// A tallied cell's modal label as the report prints it, and whether the seed (or the hardware)
 /// accepts it; every tallied table uses it. A tie (e.g. 6 / 6 of 12) is printed as one and matches
 /// only if every tied label is accepted: which of them comes first is only the order of the trials.
 struct ModalCell {
   std::string text;
   bool ok = false;
+  bool ran = true;  ///< false when "error" (a trial that could not run) is a modal label
 };
 ModalCell modalCell(const std::string& expected, const std::vector<Outcome>& outcomes) {
   const std::vector<std::string> labels = v::modalLabels(outcomes);
@@ -157,6 +169,7 @@ ModalCell modalCell(const std::string& expected, const std::vector<Outcome>& out
   for (std::size_t i = 0; i < labels.size(); ++i) {
     cell.text += (i ? " / " : "") + labels[i];
     cell.ok = cell.ok && v::accepts(expected, labels[i]);
+    cell.ran = cell.ran && labels[i] != "error";
   }
   if (labels.size() > 1) cell.text = "tie: " + cell.text;
   return cell;
@@ -628,7 +641,7 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
     for (const v::ReferenceValue& r : c.references) md << " | " << r.text;
     md << " | " << m.text << " (" << summary(ours) << ")";
     if (tallied) {
-      md << " | " << mark(t.key(c), m.ok, tallies[t.group]);
+      md << " | " << markRun(t.key(c), m.ok, m.ran, tallies[t.group]);
       ++table.total;
       table.match += m.ok;
     }
@@ -845,6 +858,25 @@ int main(int argc, char** argv) {
         "recommended step, gravity and quickstep iterations (sidecar `solver_iterations`: Medium 25, "
         "Detailed 40, others the world default 20). The front gripper's servos hold elevation 0 (as the powered real "
         "gripper does); the side arm is held folded by the core.\n\n";
+  // The report so far is saved after every section as report.partial.md, so that a run stopped
+  // part-way (Ctrl-C, a killed job, a full disk at the end) keeps the sections it finished; the
+  // finished run removes it.
+  std::vector<std::string> to_come;
+  for (const v::ReportEntry& e : tables.report)
+    if (want(e.name())) to_come.push_back(e.name());
+  const std::string partial = o.out + "/" + kPartialReportFile;
+  auto checkpoint = [&] {
+    std::string note = "\n---\n*Partial report: sbot_validate did not finish this run (or is still running it). The "
+                       "sections above are complete; not reached:";
+    for (const std::string& s : to_come) note += " " + s;
+    note += ". No summary or exit status was written.*\n";
+    try {
+      sbot::writeTextFileAtomically(partial, md.str() + note);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "sbot_validate: warning: the partial report was not saved: %s\n", e.what());
+    }
+  };
+  checkpoint();
   std::map<std::string, Tally> tallies;
   for (const v::ReportEntry& e : tables.report) {
     if (!want(e.name())) continue;
@@ -857,6 +889,8 @@ int main(int argc, char** argv) {
     } else {
       writeTable(md, e.table, o, tallies);
     }
+    to_come.erase(to_come.begin());
+    checkpoint();
   }
 
   md << "## Summary\n\n";
@@ -893,6 +927,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "sbot_validate: the report was not saved (it is printed above): %s\n", e.what());
     return 2;
   }
+  std::remove(partial.c_str());
   progress("wrote " + o.out + "/report.md (" + counts + ")");
   if (!g_error_cells.empty()) {
     std::fprintf(stderr, "sbot_validate: %zu cell(s) had trials that could not run: %s\n", g_error_cells.size(),

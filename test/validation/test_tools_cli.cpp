@@ -3,13 +3,22 @@
 // message that names the option and what was found (atoi/atof used to turn "abc" into a silent 0 runs
 // or trials).
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "../common/run_process.h"
 
@@ -289,6 +298,118 @@ TEST(ToolsCli, AnOutputPlaceThatCannotBeWrittenIsRefusedBeforeAnyRun) {
   std::string first;
   std::getline(report, first);
   EXPECT_EQ(first, "# swarmbot3d validation report");
+}
+
+// sbot_validate started in the background (argument words, no shell), its output in `log`.
+pid_t startValidate(const std::vector<std::string>& args, const std::string& log) {
+  std::vector<std::string> words{std::string(SWARMBOT3D_BIN_DIR) + "/sbot_validate"};
+  words.insert(words.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& w : words) argv.push_back(&w[0]);
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  pid_t pid = -1;
+  const int err = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  return err == 0 ? pid : -1;
+}
+
+std::string fileText(const std::string& path) {
+  std::ifstream in(path);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+/// Polls (every 20 ms, up to `seconds`) until `ready` holds; false if it never did.
+template <class F>
+bool waitFor(F ready, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    if (ready()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return ready();
+}
+
+/// A tables file of two tables: a quick one (two Fast gaps) and Detailed gaps of 30 mm and up, one per mm.
+std::string twoTables(const std::string& dir, int detailed_cells) {
+  std::ostringstream t;
+  t << "groups:\n  - {name: lab, title: Lab cells}\nreport:\n"
+       "  - table:\n      id: quick\n      title: Quick gaps\n      group: lab\n      experiment: gap\n      level: fast\n"
+       "      param: {unit: mm, scale: 1000, decimals: 0}\n      references: [measured]\n      cells:\n"
+       "        - {param: 0.030, measured: pass}\n"
+       "  - table:\n      id: slow\n      title: Slow gaps\n      group: lab\n      experiment: gap\n      level: detailed\n"
+       "      param: {unit: mm, scale: 1000, decimals: 0}\n      references: [measured]\n      cells:\n";
+  for (int k = 0; k < detailed_cells; ++k) t << "        - {param: " << 0.030 + 0.001 * k << ", measured: pass}\n";
+  std::ofstream(dir + "tables.yaml") << t.str();
+  return dir + "tables.yaml";
+}
+
+// A run stopped part-way (Ctrl-C, a killed job) used to lose every finished section: the report was
+// written only at the end. The report so far is kept as report.partial.md, section by section, and
+// the finished run replaces it by report.md.
+TEST(ToolsCli, AStoppedRunKeepsTheSectionsItFinished) {
+  const std::string dir = testing::TempDir() + "cli_stopped/";
+  std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str());
+  const std::string tables = twoTables(dir, 40);
+  const pid_t pid = startValidate({"--trials", "1", "--jobs", "1", "--out", dir + "report", "--tables", tables}, dir + "log");
+  ASSERT_GT(pid, 0);
+  const std::string partial = dir + "report/report.partial.md";
+  const bool quick_done = waitFor([&] { return fileText(partial).find("## Quick gaps") != std::string::npos; }, 60);
+  kill(pid, SIGTERM);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(quick_done) << fileText(dir + "log");
+  const std::string text = fileText(partial);
+  EXPECT_NE(text.find("| 30 mm | pass | pass (pass 1/1) | match |"), std::string::npos) << text;
+  EXPECT_NE(text.find("The sections above are complete; not reached: slow."), std::string::npos) << text;
+  EXPECT_EQ(text.find("## Slow gaps"), std::string::npos) << "stopped during the second table: " << text;
+  EXPECT_NE(access((dir + "report/report.md").c_str(), F_OK), 0) << "no report.md from a run that did not finish";
+  // A finished run leaves its report and no partial one.
+  const Outcome done = run("sbot_validate", "--trials 1 --jobs 1 --out " + dir + "report --tables " + twoTables(dir, 1));
+  EXPECT_EQ(done.status, 0) << done.output;
+  EXPECT_NE(access((dir + "report/report.md").c_str(), F_OK), -1);
+  EXPECT_NE(access(partial.c_str(), F_OK), 0) << "the partial report of the stopped run was left";
+}
+
+// A worker process that dies (an ODE assertion, the OOM killer) costs the trial it was running, not
+// the run: the report marks that cell "error", lists it in the summary, and the exit status is 3 (not
+// 1, as if the model had failed the cell).
+TEST(ToolsCli, AKilledWorkerCostsOnlyItsTrialAndTheRunEndsWithStatus3) {
+  const std::string dir = testing::TempDir() + "cli_killed_worker/";
+  std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str());
+  const std::string tables = twoTables(dir, 4);
+  const pid_t pid = startValidate({"--trials", "1", "--jobs", "1", "--out", dir + "report", "--only", "slow", "--tables", tables},
+                                  dir + "log");
+  ASSERT_GT(pid, 0);
+  // The Detailed table's worker: the first child of the run (the quick table is not run).
+  pid_t worker = -1;
+  waitFor([&] {
+    FILE* p = popen(("pgrep -P " + std::to_string(pid)).c_str(), "r");
+    if (p && std::fscanf(p, "%d", &worker) != 1) worker = -1;
+    if (p) pclose(p);
+    return worker > 0;
+  }, 60);
+  ASSERT_GT(worker, 0) << fileText(dir + "log");
+  kill(worker, SIGKILL);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  const std::string log = fileText(dir + "log");
+  ASSERT_TRUE(WIFEXITED(status)) << log;
+  EXPECT_EQ(WEXITSTATUS(status), 3) << log;
+  EXPECT_NE(log.find("a worker process died of signal 9"), std::string::npos) << log;
+  // Which cell was lost depends on when the kill landed (usually the first): one, and only one.
+  EXPECT_NE(log.find("1 cell(s) had trials that could not run: slow 3"), std::string::npos) << log;
+  int ran = 0;
+  for (std::size_t at = 0; (at = log.find("| pass | pass (pass 1/1) | match |", at)) != std::string::npos; ++at) ++ran;
+  EXPECT_EQ(ran, 3) << "the other cells ran: " << log;
+  const std::string report = fileText(dir + "report/report.md");
+  EXPECT_NE(report.find("- Cells with trials that could not run (\"error\"; the cause is on stderr): slow 3"), std::string::npos)
+      << report;
+  EXPECT_NE(report.find("| error (error 1/1) | **error** (could not run) |"), std::string::npos) << report;
+  EXPECT_EQ(report.find("not explained yet"), std::string::npos) << "a cell that did not run is no model mismatch: " << report;
 }
 
 // --scenario FILE --trial ...: the trial's world and start as a scenario file for the node (to watch

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cerrno>
 #include <cstring>
 
@@ -76,6 +77,16 @@ void writeTextFile(const std::string& path, const std::string& text) {
   OutputFile f(path);
   f << text;
   f.commit();
+}
+
+void writeTextFileAtomically(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  writeTextFile(tmp, text);
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    std::remove(tmp.c_str());
+    throw OutputError("cannot write '" + path + "': renaming '" + tmp + "' over it: " + reason(err));
+  }
 }
 
 }  // namespace sbot

@@ -96,6 +96,21 @@ TEST(OutputFiles, WritesAndReplacesAFile) {
   EXPECT_EQ(s.str(), "second\n");
 }
 
+TEST(OutputFiles, AnAtomicWriteReplacesTheFileAndLeavesNoTemporary) {
+  TempDir t;
+  const std::string path = t.path() + "/report.partial.md";
+  writeTextFileAtomically(path, "one section\n");
+  writeTextFileAtomically(path, "two sections\n");
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  EXPECT_EQ(s.str(), "two sections\n");
+  EXPECT_NE(::access((path + ".tmp").c_str(), F_OK), 0) << "the temporary file was left behind";
+  // Where the temporary cannot be made, the error names it, and the old file is kept.
+  const std::string m = messageOf([&] { writeTextFileAtomically(t.path() + "/missing_dir/report.md", "x"); });
+  EXPECT_NE(m.find("missing_dir/report.md.tmp"), std::string::npos) << m;
+}
+
 TEST(OutputFiles, AFileThatCannotBeOpenedIsRefusedAtOnce) {
   TempDir t;
   const std::string m = messageOf([&] { OutputFile f(t.path() + "/missing_dir/report.md"); });

@@ -41,4 +41,9 @@ class OutputFile : public std::ofstream {
 /// Writes `text` to `path` (replacing it), checked as OutputFile.
 void writeTextFile(const std::string& path, const std::string& text);
 
+/// As writeTextFile, but through `path`.tmp renamed over `path`: a reader, or a process killed
+/// during the write, sees the old file or the new one, never half of one (a report rewritten as a
+/// long run goes on).
+void writeTextFileAtomically(const std::string& path, const std::string& text);
+
 }  // namespace sbot
