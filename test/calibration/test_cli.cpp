@@ -122,6 +122,28 @@ TEST(Cli, APerSurfaceEffectIsFittedOnTheDatasetsSurfacesOrRefused) {
   EXPECT_FALSE(exists(dir + "none.yaml"));
 }
 
+// A fit stopped by its iteration limit is not at a minimum, and the curvature there gave an interval
+// that excluded the truth (accel_limit 2.103 +- 0.002 for 2.0). Its values are written with no
+// interval and a note, and a warning says how to go on.
+TEST(Cli, AFitStoppedByItsIterationLimitGivesNoInterval) {
+  const std::string dir = freshDir("cli_iteration_limit");
+  const Outcome cut = run("fit " + kIrPoints + " --effect ir_reflectance --quiet --max-iterations 1 --out " + dir + "cut.yaml");
+  EXPECT_EQ(cut.status, 0) << cut.output;
+  EXPECT_TRUE(contains(cut.output, "(no interval: not converged)")) << cut.output;
+  EXPECT_TRUE(contains(cut.output, "warning: the fit stopped at its iteration limit (1) before converging")) << cut.output;
+  const std::string file = readFile(dir + "cut.yaml");
+  EXPECT_FALSE(contains(file, "stderr:")) << file;
+  EXPECT_TRUE(contains(file, "not converged: sbot_calibrate fit on seed_ir_response stopped at its iteration limit (1)")) << file;
+  // Given the iterations it needs, the same fit converges and states its interval.
+  const Outcome done = run("fit " + kIrPoints + " --effect ir_reflectance --quiet --max-iterations 10 --out " + dir + "done.yaml");
+  EXPECT_EQ(done.status, 0) << done.output;
+  EXPECT_TRUE(contains(done.output, "(95 %)")) << done.output;
+  EXPECT_TRUE(contains(readFile(dir + "done.yaml"), "stderr: {white_paper: ")) << readFile(dir + "done.yaml");
+  const Outcome bad = run("fit " + kIrPoints + " --effect ir_reflectance --max-iterations 0 --out " + dir + "bad.yaml");
+  EXPECT_EQ(bad.status, 1) << bad.output;
+  EXPECT_TRUE(contains(bad.output, "--max-iterations")) << bad.output;
+}
+
 // An effect on channels the dataset does not measure used to be "fitted" (exponent = 0 +- 1e+06)
 // or screened without a word.
 TEST(Cli, AnEffectOnChannelsTheDatasetDoesNotMeasureIsRefusedOrNoted) {
