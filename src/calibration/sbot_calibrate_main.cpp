@@ -389,8 +389,9 @@ int cmdDiagnose(const Args& a) {
   if (a.has("write-effects")) checkOutputPlace("write-effects", a.get("write-effects"), false);
   WorkerPool& pool = WorkerPool::global();
   const int folds = foldCount(ds, o.folds);
-  std::printf("diagnose %s: %zu runs, %zu samples, level %s, %d folds, %d worker processes\n", ds.name.c_str(), ds.runs.size(),
-              ds.sampleCount(), o.base.level.c_str(), folds, pool.size());
+  std::printf("diagnose %s: %zu runs, %zu samples, level %s, %d fold%s, %d worker process%s\n", ds.name.c_str(),
+              ds.runs.size(), ds.sampleCount(), o.base.level.c_str(), folds, folds == 1 ? "" : "s", pool.size(),
+              pool.size() == 1 ? "" : "es");
   if (folds < o.folds)
     std::printf("note: --folds %d, but a fold holds out whole runs and the dataset has %zu run%s: %d fold%s\n", o.folds,
                 ds.runs.size(), ds.runs.size() == 1 ? "" : "s", folds, folds == 1 ? " (scores in-sample)" : "s");
@@ -544,6 +545,35 @@ int cmdGenerate(const Args& a) {
   return 0;
 }
 
+int cmdSweep(const Args& a) {
+  SweepOptions o;
+  o.gen.level = a.get("level", "simple");
+  loadLevel(o.gen.level);
+  o.gen.solver = solverOption(a, "quickstep");
+  o.gen.duration = a.num("duration", 8);
+  o.gen.measure_torque = a.has("torque");
+  checkGeneratorOptions(o.gen);
+  o.seeds = static_cast<int>(a.whole("seeds", 10, 1, 10000, "synthetic datasets per case"));
+  o.first_seed = static_cast<std::uint64_t>(a.whole("first-seed", 1, 0, LLONG_MAX));
+  o.diag.folds = static_cast<int>(a.whole("folds", 2, 2, INT_MAX, "each fold's runs are scored by a fit on the others"));
+  o.diag.bic_threshold = a.num("threshold", 10);
+  o.progress = !a.has("quiet");
+  std::vector<std::string> names;
+  if (a.has("cases")) {
+    names = splitList(a.get("cases"), ',');
+    if (names.empty()) throw std::invalid_argument("--cases expects a list of sweep case names, got ''");
+  }
+  o.cases = selectSweepCases(o.gen.level, names, a.has("set") ? parseEffectList(a.get("set"), "--set") : std::vector<EffectConfig>{});
+  if (a.has("out")) checkOutputPlace("out", a.get("out"), false);
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto res = runSweep(o, WorkerPool::global());
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::string md = sweepMarkdown(res, o, secs);
+  std::printf("%s", md.c_str());
+  if (a.has("out")) writeTextFile(a.get("out"), md);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -560,8 +590,7 @@ int main(int argc, char** argv) {
     if (a.cmd == "diagnose") return cmdDiagnose(a);
     if (a.cmd == "fit") return cmdFit(a);
     if (a.cmd == "generate") return cmdGenerate(a);
-    if (a.has("out")) checkOutputPlace("out", a.get("out"), false);  // sweep
-    return runSweepCommand(a.opts, a.flags);
+    return cmdSweep(a);
   } catch (const UnknownCommand& e) {
     std::fprintf(stderr, "sbot_calibrate: %s\n", e.what());
     usage();

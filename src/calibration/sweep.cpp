@@ -255,7 +255,7 @@ std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool) {
 
 std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions& opt, double seconds) {
   std::ostringstream md;
-  md << "Sweep: " << opt.seeds << " seeds per case, level " << opt.gen.level << " (unless the case names one), drive patterns of "
+  md << "Sweep: " << opt.seeds << (opt.seeds == 1 ? " seed" : " seeds") << " per case, level " << opt.gen.level << " (unless the case names one), drive patterns of "
      << opt.gen.duration << " s, solver " << opt.gen.solver << ", " << opt.diag.folds << "-fold split by run, acceptance dBIC > "
      << opt.diag.bic_threshold << "; " << std::fixed << std::setprecision(0) << seconds << " s wall.\n\n";
   md << "| hidden | truth | right first | params +-10 % | held-out RMS -50 % | ends <= 1.2x floor | failing channels -50 % | "
@@ -306,56 +306,33 @@ std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions&
   return md.str();
 }
 
-int runSweepCommand(const std::multimap<std::string, std::string>& opts, const std::set<std::string>& flags) {
-  auto get = [&](const std::string& k, const std::string& def) {
-    auto it = opts.find(k);
-    return it == opts.end() ? def : it->second;
-  };
-  SweepOptions o;
-  o.gen.level = get("level", "simple");
-  o.gen.solver = get("solver", "quickstep");
-  o.gen.duration = std::stod(get("duration", "8"));
-  o.gen.measure_torque = flags.count("torque") != 0;
-  o.seeds = std::stoi(get("seeds", "10"));
-  o.first_seed = std::stoull(get("first-seed", "1"));
-  o.diag.folds = std::stoi(get("folds", "2"));
-  o.diag.bic_threshold = std::stod(get("threshold", "10"));
-  o.progress = !flags.count("quiet");
-  auto all = standardCases(o.gen.level);
-  if (opts.count("cases")) {
-    for (const auto& name : splitList(get("cases", ""), ',')) {
-      bool found = false;
-      for (const auto& c : all)
-        if (c.name == name) {
-          o.cases.push_back(c);
-          found = true;
+std::vector<SweepCase> selectSweepCases(const std::string& level, const std::vector<std::string>& names,
+                                        const std::vector<EffectConfig>& magnitudes) {
+  const std::vector<SweepCase> all = standardCases(level);
+  std::vector<SweepCase> cases;
+  for (const auto& name : names) {
+    auto it = std::find_if(all.begin(), all.end(), [&](const SweepCase& c) { return c.name == name; });
+    if (it == all.end()) {
+      std::string known;
+      for (const auto& c : all) known += (known.empty() ? "" : ", ") + c.name;
+      throw std::invalid_argument("--cases: unknown sweep case '" + name + "' (known: " + known + ")");
+    }
+    cases.push_back(*it);
+  }
+  if (names.empty()) cases = all;
+  // Another magnitude for the selected cases that hide that effect (how small an effect diagnose
+  // still finds; the standard magnitudes are in standardCases).
+  for (const auto& over : magnitudes) {
+    bool used = false;
+    for (auto& c : cases)
+      for (auto& h : c.hidden)
+        if (h.name == over.name) {
+          for (const auto& [k, v] : over.params) h.params[k] = v;
+          used = true;
         }
-      if (!found) throw std::invalid_argument("unknown sweep case '" + name + "'");
-    }
-  } else {
-    o.cases = all;
+    if (!used) throw std::invalid_argument("--set " + over.name + ": no selected sweep case hides that effect");
   }
-  // --set effect:param=value: another magnitude for the selected cases that hide that effect (how
-  // small an effect diagnose still finds; the standard magnitudes are in standardCases).
-  if (opts.count("set")) {
-    for (const auto& over : parseEffectList(get("set", ""), "--set")) {
-      bool used = false;
-      for (auto& c : o.cases)
-        for (auto& h : c.hidden)
-          if (h.name == over.name) {
-            for (const auto& [k, v] : over.params) h.params[k] = v;
-            used = true;
-          }
-      if (!used) throw std::invalid_argument("--set " + over.name + ": no selected sweep case hides that effect");
-    }
-  }
-  const auto t0 = std::chrono::steady_clock::now();
-  const auto res = runSweep(o, WorkerPool::global());
-  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const std::string md = sweepMarkdown(res, o, secs);
-  std::printf("%s", md.c_str());
-  if (opts.count("out")) writeTextFile(get("out", ""), md);
-  return 0;
+  return cases;
 }
 
 }  // namespace sbot::calib

@@ -69,7 +69,10 @@ struct SweepOptions {
 std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool);
 std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions& opt, double seconds);
 
-/// `sbot_calibrate sweep` (options as parsed by the command line).
-int runSweepCommand(const std::multimap<std::string, std::string>& opts, const std::set<std::string>& flags);
+/// The standard cases of `level` named in `names` (all of them when empty), the hidden effects' parameters
+/// replaced by those `magnitudes` (sweep --set) give. Throws std::invalid_argument naming an unknown case
+/// (and the known ones), or a magnitude for an effect no selected case hides.
+std::vector<SweepCase> selectSweepCases(const std::string& level, const std::vector<std::string>& names,
+                                        const std::vector<EffectConfig>& magnitudes);
 
 }  // namespace sbot::calib

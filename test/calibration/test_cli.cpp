@@ -193,9 +193,36 @@ TEST(Cli, OptionValuesOutsideTheirRangeAndStrayArgumentsAreRefusedByName) {
   // More folds than runs: the folds it uses are announced, not those asked for.
   const Outcome few = run("diagnose " + kIrPoints + " --quiet --folds 3");
   EXPECT_EQ(few.status, 0) << few.output;
-  EXPECT_TRUE(contains(few.output, "level medium, 1 folds,")) << few.output;
+  EXPECT_TRUE(contains(few.output, "level medium, 1 fold,")) << few.output;
   EXPECT_TRUE(contains(few.output, "note: --folds 3, but a fold holds out whole runs and the dataset has 1 run: 1 fold (scores in-sample)"))
       << few.output;
+}
+
+// sweep read its options with bare stoi/stod: "--seeds abc" stopped with the message "stoi", "--seeds
+// 2.5" ran 2 seeds, "--duration nan" and an unknown --level or --solver reached the generator. They are
+// checked as every other subcommand's, before any dataset is generated.
+TEST(Cli, SweepOptionsAreCheckedByName) {
+  auto refused = [](const std::string& args, const std::string& message) {
+    const Outcome o = run("sweep --quiet " + args);
+    EXPECT_EQ(o.status, 1) << args << ": " << o.output;
+    EXPECT_TRUE(contains(o.output, "sbot_calibrate: " + message)) << args << ": " << o.output;
+  };
+  refused("--seeds abc", "--seeds expects a whole number from 1 to 10000 (synthetic datasets per case), got 'abc'");
+  refused("--seeds 2.5", "--seeds expects a whole number from 1 to 10000 (synthetic datasets per case), got '2.5'");
+  refused("--first-seed -1", "--first-seed expects a whole number from 0 to ");
+  refused("--folds 1", "--folds expects a whole number of at least 2");
+  refused("--threshold nan", "--threshold expects a finite number, got 'nan'");
+  refused("--duration 1", "--duration expects 2 to 3600 s");
+  refused("--solver fast", "--solver expects quickstep or exact, got 'fast'");
+  refused("--level huge", "unknown model level 'huge'");
+  refused("--cases none,nonsuch", "--cases: unknown sweep case 'nonsuch' (known: speed_scale, ");
+  refused("--cases \"\"", "--cases expects a list of sweep case names, got ''");
+  refused("--cases none --set latency:delay=0.2", "--set latency: no selected sweep case hides that effect");
+  // And a sweep of one case and one short seed runs (a few seconds).
+  const Outcome ok = run("sweep --quiet --cases none --seeds 1 --duration 3");
+  EXPECT_EQ(ok.status, 0) << ok.output;
+  EXPECT_TRUE(contains(ok.output, "Sweep: 1 seed per case, level simple")) << ok.output;
+  EXPECT_TRUE(contains(ok.output, "- **none**: s1 {none} ")) << ok.output;
 }
 
 // diagnose --write-effects wrote nothing when nothing was accepted, so `compare --effects FILE`,
