@@ -20,7 +20,7 @@ earliest stamp of the run (not the first message read: a tracker whose header st
 commands would otherwise get negative times). Topics that are absent are simply not measured. The start pose is the
 first tracker pose. The world (obstacles, lamps) is copied from --world (a YAML file with the
 dataset's `world:` mapping) and the model level from --level. With --append, runs are added to an
-existing dataset. Message classes are taken from the bag itself, so the workspace need not be sourced.
+existing dataset: of its level and world (a --level or --world that differs is refused). Message classes are taken from the bag itself, so the workspace need not be sourced.
 """
 import argparse
 import math
@@ -152,7 +152,8 @@ def main(argv=None):
     p.add_argument("out", help="dataset directory (created)")
     p.add_argument("bags", nargs="+", help="bag files, one run each")
     p.add_argument("--robot", default="sbot_0", help="robot namespace (default sbot_0)")
-    p.add_argument("--level", default="medium", choices=LEVELS, help="model level of the dataset (default medium)")
+    p.add_argument("--level", default=None, choices=LEVELS,
+                   help="model level of the dataset (default medium; with --append, the dataset's)")
     p.add_argument("--name", default=None, help="dataset name (default: the directory name)")
     p.add_argument("--run-name", default=None, help="run name (single bag only)")
     p.add_argument("--world", default=None, help="YAML file with the dataset's world mapping")
@@ -173,14 +174,21 @@ def main(argv=None):
 
     yaml_path = os.path.join(a.out, "dataset.yaml")
     if a.append and os.path.exists(yaml_path):
-        with open(yaml_path) as f:
-            ds = yaml.safe_load(f)
+        ds = read_existing(yaml_path)
+        # One dataset is one robot in one world: runs of another level, or a world that would be
+        # applied to the runs already there, are refused rather than mixed in.
+        if a.level and a.level != ds.get("robot"):
+            raise SystemExit("bag_to_dataset: --append: %s is a dataset of level '%s', not --level %s; import into "
+                             "another directory" % (yaml_path, ds.get("robot"), a.level))
+        if a.world and read_world(a.world) != ds.get("world"):
+            raise SystemExit("bag_to_dataset: --append: --world %s differs from the world of %s, which its runs were "
+                             "measured in; import into another directory" % (a.world, yaml_path))
     else:
         ds = {"format": "sbot-dataset/1", "name": a.name or os.path.basename(os.path.abspath(a.out)),
-              "description": "imported from rosbag by bag_to_dataset.py", "robot": a.level,
+              "description": "imported from rosbag by bag_to_dataset.py", "robot": a.level or "medium",
               "world": {"terrain": {"type": "plane"}}, "runs": []}
-    if a.world:
-        ds["world"] = read_world(a.world)
+        if a.world:
+            ds["world"] = read_world(a.world)
     # Read every bag before writing anything: an unreadable bag stops the import with its name and
     # leaves the output directory as it was (no CSV without its dataset.yaml entry).
     imported = []
@@ -201,6 +209,18 @@ def main(argv=None):
     except OSError as error:
         raise SystemExit("bag_to_dataset: cannot write %s: %s" % (error.filename or a.out, error.strerror))
     return 0
+
+
+def read_existing(yaml_path):
+    """The dataset.yaml that --append adds to; SystemExit naming it when it is not one."""
+    try:
+        with open(yaml_path) as f:
+            ds = yaml.safe_load(f)
+    except (OSError, yaml.YAMLError) as error:
+        raise SystemExit("bag_to_dataset: --append: cannot read %s: %s" % (yaml_path, error))
+    if not isinstance(ds, dict) or not isinstance(ds.get("runs"), list):
+        raise SystemExit("bag_to_dataset: --append: %s is not a dataset (a mapping with a 'runs' list)" % yaml_path)
+    return ds
 
 
 def write_dataset(a, ds, imported, yaml_path):

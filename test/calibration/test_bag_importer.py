@@ -18,6 +18,7 @@ import genpy
 import genpy.dynamic
 import rosbag
 import rospy
+import yaml
 
 HERE = os.path.dirname(os.path.realpath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -184,6 +185,31 @@ class BagImporterTest(unittest.TestCase):
             bag_to_dataset.main([out, good, "--world", listed, "--tracker-topic", "/tracker/sbot_0"])
         self.assertIn("--world %s: expected the dataset's world mapping" % listed, str(e.exception))
         self.assertFalse(os.path.exists(out))
+
+    def test_append_adds_runs_of_the_same_robot_and_world_only(self):
+        # --append used to ignore --level and --world replaced the world of the runs already there.
+        first = os.path.join(self.tmp, "append_first.bag")
+        self.write_bag("straight_20", first)
+        out = os.path.join(self.tmp, "appended")
+        self.assertEqual(bag_to_dataset.main([out, first, "--tracker-topic", "/tracker/sbot_0", "--level", "simple"]), 0)
+        second = os.path.join(self.tmp, "append_second.bag")
+        self.write_bag("spin_cw_30", second)
+        with self.assertRaises(SystemExit) as e:
+            bag_to_dataset.main([out, second, "--append", "--level", "detailed", "--tracker-topic", "/tracker/sbot_0"])
+        self.assertIn("is a dataset of level 'simple', not --level detailed", str(e.exception))
+        world = os.path.join(self.tmp, "other_world.yaml")
+        with open(world, "w") as f:
+            f.write("terrain: {type: plane}\nlamps: [{position: [1, 0, 0.2]}]\n")
+        with self.assertRaises(SystemExit) as e:
+            bag_to_dataset.main([out, second, "--append", "--world", world, "--tracker-topic", "/tracker/sbot_0"])
+        self.assertIn("--world %s differs from the world of" % world, str(e.exception))
+        self.assertFalse(os.path.exists(os.path.join(out, "append_second.csv")), "a refused append wrote a run")
+        # Without --level (or with the dataset's own), the run joins the dataset at its level.
+        self.assertEqual(bag_to_dataset.main([out, second, "--append", "--tracker-topic", "/tracker/sbot_0"]), 0)
+        with open(os.path.join(out, "dataset.yaml")) as f:
+            ds = yaml.safe_load(f)
+        self.assertEqual(ds["robot"], "simple")
+        self.assertEqual([r["name"] for r in ds["runs"]], ["append_first", "append_second"])
 
     def test_an_unknown_level_is_refused(self):
         good = os.path.join(self.tmp, "good_for_level.bag")
