@@ -238,13 +238,6 @@ std::size_t Dataset::sampleCount() const {
   return n;
 }
 
-const std::set<std::string>& knownSurfaces() {
-  static const std::set<std::string> s{"ground",      "wall",       "white_paper", "grey_paper", "black_card",
-                                       "wood",        "polystyrene", "aluminium",  "cardboard",  "plastic",
-                                       "sbot",        "chassis",     "track",      "stickable",  "mirror"};
-  return s;
-}
-
 bool isKnownColumn(const std::string& c) {
   static const std::set<std::string> fixed{"t",           "cmd_left",     "cmd_right",   "x",        "y",
                                            "yaw",         "z",            "speed_left",  "speed_right",

@@ -124,8 +124,6 @@ struct Dataset {
   std::size_t sampleCount() const;
 };
 
-/// Surface labels a dataset may use (optical / contact labels understood by the sensor effects).
-const std::set<std::string>& knownSurfaces();
 /// Every column name a run file may have.
 bool isKnownColumn(const std::string& name);
 

@@ -56,36 +56,13 @@ std::vector<EffectConfig> parseEffectList(const std::string& spec, const std::st
     }
   }
   makeEffects(out, source);  // validate
-  checkEffectConfigs(out, source);
+  checkEffectSurfaces(out, source);
   return out;
-}
-
-void checkEffectConfigs(const std::vector<EffectConfig>& configs, const std::string& source,
-                        const std::set<std::string>& surfaces) {
-  const EffectRegistry& reg = EffectRegistry::instance();
-  for (std::size_t i = 0; i < configs.size(); ++i) {
-    const EffectConfig& c = configs[i];
-    const EffectInfo& info = reg.info(c.name);
-    const std::string field = "effects[" + std::to_string(i) + "]";
-    if (info.open_params) {
-      std::set<std::string> labels = knownSurfaces();
-      labels.insert(surfaces.begin(), surfaces.end());
-      for (const auto& [surface, v] : c.params) {
-        if (labels.count(surface)) continue;
-        std::string list;
-        for (const auto& l : labels) list += (list.empty() ? "" : ", ") + l;
-        throw ConfigError(source, field + ".params." + surface,
-                          c.name + ": unknown surface '" + surface + "' (known: " + list +
-                              "; a dataset declares others under 'surfaces:' and uses them on its obstacles)");
-      }
-    }
-    // (A stderr for a value params does not give is refused by the core's loader.)
-  }
 }
 
 std::vector<EffectConfig> loadCheckedEffects(const std::string& path, const std::set<std::string>& surfaces) {
   std::vector<EffectConfig> configs = loadEffectsConfig(path);
-  checkEffectConfigs(configs, path, surfaces);
+  checkEffectSurfaces(configs, path, surfaces);
   return configs;
 }
 

@@ -22,13 +22,7 @@ void requireEffect(const std::string& name, const std::string& option);
 /// out of bounds, an unknown surface: errors naming `source`).
 std::vector<EffectConfig> parseEffectList(const std::string& spec, const std::string& source);
 
-/// What the effects library's loader leaves unchecked (ConfigError naming `source` and the field):
-/// a per-surface parameter (ir_reflectance) whose surface label is neither known (knownSurfaces) nor
-/// in `surfaces` (e.g. a dataset's obstacle labels): it would never act.
-void checkEffectConfigs(const std::vector<EffectConfig>& configs, const std::string& source,
-                        const std::set<std::string>& surfaces = {});
-
-/// loadEffectsConfig(path) and checkEffectConfigs.
+/// loadEffectsConfig(path) and checkEffectSurfaces (effects_file.h) with the dataset's `surfaces`.
 std::vector<EffectConfig> loadCheckedEffects(const std::string& path, const std::set<std::string>& surfaces = {});
 
 }  // namespace sbot::calib

@@ -88,6 +88,20 @@ double treelsFrictionScale(const GeomInfo* a, const GeomInfo* b) {
 
 }  // namespace
 
+const std::set<std::string>& knownSurfaces() {
+  static const std::set<std::string> s{"ground",      "wall",       "white_paper", "grey_paper", "black_card",
+                                       "wood",        "polystyrene", "aluminium",  "cardboard",  "plastic",
+                                       "sbot",        "chassis",     "track",      "stickable",  "mirror"};
+  return s;
+}
+
+std::set<std::string> surfaceLabels(const TerrainConfig& terrain) {
+  std::set<std::string> labels;
+  if (terrain.ground_plane) labels.insert("ground");
+  for (const BoxObstacle& b : terrain.boxes) labels.insert(b.surface);
+  return labels;
+}
+
 double ContactConfig::muFor(const std::string& a, const std::string& b) const {
   // A material with its own coefficient overrides the default surface; two such materials in
   // contact use the lower of the two.

@@ -190,7 +190,7 @@ std::unique_ptr<sbot::World> SimRosInterface::buildWorld() const {
   if (!scenario_.effects_file.empty()) {
     // The calibration workbench's effects file: throws ConfigError naming file and field.
     std::string names;
-    for (const sbot::EffectPtr& e : sbot::loadEffectsFile(scenario_.effects_file)) {
+    for (const sbot::EffectPtr& e : sbot::loadEffectsFile(scenario_.effects_file, sbot::surfaceLabels(scenario_.world.terrain))) {
       world->addEffect(e);
       names += (names.empty() ? "" : ", ") + e->name();
     }

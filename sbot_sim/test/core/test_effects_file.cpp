@@ -4,10 +4,12 @@
 
 #include <cstdio>
 #include <fstream>
+#include <set>
 
 #include "sbot_sim/core/effects/effect_registry.h"
 #include "sbot_sim/core/effects/effects_file.h"
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/world_config.h"
 
 namespace sbot::test {
 namespace {
@@ -65,6 +67,28 @@ TEST(EffectsFile, ErrorsNameTheField) {
   EXPECT_EQ(fieldOf("effects: [{name: latency, params: {delay: 0.1}}, {name: latency, delay: 1}]"), "effects[1].delay");
   EXPECT_EQ(fieldOf("effects:\n  - name: latency\n    name: speed_scale\n"), "") << "a repeated key names the file";
   EXPECT_THROW(loadEffectsFile("/nonexistent/effects.yaml"), ConfigError);
+}
+
+// A per-surface parameter whose label names no surface would never act: the simulator node loaded
+// `ir_reflectance: {whte_paper: 0.5}` and ran with white paper unchanged. Labels are the library's
+// (knownSurfaces) and the world's own (a scenario box's surface).
+TEST(EffectsFile, APerSurfaceParameterMustNameASurface) {
+  const std::string path = testing::TempDir() + "effects_surfaces.yaml";
+  std::ofstream(path) << "effects: [{name: ir_reflectance, params: {white_paper: 0.9, whte_paper: 0.5}}]\n";
+  try {
+    loadEffectsFile(path);
+    FAIL() << "an unknown surface was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("effects[0].params.whte_paper"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("ir_reflectance: unknown surface 'whte_paper' (known: "), std::string::npos) << e.what();
+  }
+  // A label of the world's own boxes is a surface.
+  TerrainConfig terrain;
+  terrain.boxes.push_back({"sheet", Vec3(1, 0, 0.05), Vec3(0.1, 0.5, 0.1), 0, 0, "whte_paper"});
+  EXPECT_EQ(surfaceLabels(terrain), (std::set<std::string>{"ground", "whte_paper"}));
+  EXPECT_EQ(loadEffectsFile(path, surfaceLabels(terrain)).size(), 1u);
+  // Effects with named parameters are not surface-checked (their names are checked by the registry).
+  EXPECT_NO_THROW(checkEffectSurfaces({{"latency", {{"delay", 0.1}}, {}, ""}}, "test"));
 }
 
 TEST(EffectsFile, WriteThenReadRoundTrips) {

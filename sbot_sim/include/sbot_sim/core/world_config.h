@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,11 @@ struct BoxObstacle {
   std::string surface = "ground";  ///< contact material / optical surface label
 };
 
+/// The surface labels the library knows (materials of obstacles and floors, and the s-bot's own
+/// parts as rays and contacts see them): what a per-surface effect (ir_reflectance) may name besides
+/// a world's own labels (surfaceLabels). A dataset declares others under `surfaces:`.
+const std::set<std::string>& knownSurfaces();
+
 struct TerrainConfig {
   enum class Type { Plane, Composite, Rough };
   Type type = Type::Plane;
@@ -58,6 +64,9 @@ struct TerrainConfig {
   double height_range = 0.0;            ///< peak-to-peak height [m] (HR of Fig. 4.4 in cm / 100)
   std::uint64_t heightmap_seed = 1;
 };
+
+/// Every surface label `terrain` uses: its boxes' and, with the ground plane, "ground".
+std::set<std::string> surfaceLabels(const TerrainConfig& terrain);
 
 struct WorldConfig {
   double step = 0.01;          ///< fixed integration step [s]

@@ -13,6 +13,7 @@
 #include "sbot_sim/core/effects/effect_registry.h"
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/output_files.h"
+#include "sbot_sim/core/world_config.h"
 
 namespace sbot {
 namespace {
@@ -120,7 +121,30 @@ std::vector<EffectPtr> makeEffects(const std::vector<EffectConfig>& configs, con
   return {out.begin(), out.end()};
 }
 
-std::vector<EffectPtr> loadEffectsFile(const std::string& path) { return makeEffects(loadEffectsConfig(path), path); }
+void checkEffectSurfaces(const std::vector<EffectConfig>& configs, const std::string& source,
+                         const std::set<std::string>& world_surfaces) {
+  const EffectRegistry& reg = EffectRegistry::instance();
+  for (std::size_t i = 0; i < configs.size(); ++i) {
+    const EffectConfig& c = configs[i];
+    if (!reg.info(c.name).open_params) continue;
+    std::set<std::string> labels = knownSurfaces();
+    labels.insert(world_surfaces.begin(), world_surfaces.end());
+    for (const auto& entry : c.params) {
+      if (labels.count(entry.first)) continue;
+      std::string list;
+      for (const auto& l : labels) list += (list.empty() ? "" : ", ") + l;
+      throw ConfigError(source, "effects[" + std::to_string(i) + "].params." + entry.first,
+                        c.name + ": unknown surface '" + entry.first + "' (known: " + list +
+                            "; a dataset declares others under 'surfaces:', a scenario uses them on its boxes)");
+    }
+  }
+}
+
+std::vector<EffectPtr> loadEffectsFile(const std::string& path, const std::set<std::string>& world_surfaces) {
+  const std::vector<EffectConfig> configs = loadEffectsConfig(path);
+  checkEffectSurfaces(configs, path, world_surfaces);
+  return makeEffects(configs, path);
+}
 
 std::string effectsToYaml(const std::vector<EffectConfig>& configs, const std::string& header) {
   std::ostringstream o;

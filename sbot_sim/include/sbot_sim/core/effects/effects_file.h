@@ -12,6 +12,7 @@
 #pragma once
 
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -31,8 +32,13 @@ std::vector<EffectConfig> loadEffectsConfig(const std::string& path);
 /// Validate (names, parameters, bounds) and instantiate, in pipeline order (the registry's), not
 /// in the order listed.
 std::vector<EffectPtr> makeEffects(const std::vector<EffectConfig>& configs, const std::string& source = "<effects>");
-/// Read, validate and instantiate an effects file.
-std::vector<EffectPtr> loadEffectsFile(const std::string& path);
+/// A per-surface parameter (ir_reflectance) must name a surface of the library (knownSurfaces,
+/// world_config.h) or of `world_surfaces` (a scenario's or dataset's obstacles): any other label
+/// (a typo) would never act. ConfigError naming `source`, the field and the labels it may name.
+void checkEffectSurfaces(const std::vector<EffectConfig>& configs, const std::string& source,
+                         const std::set<std::string>& world_surfaces = {});
+/// Read, validate (names, parameters, bounds, surfaces) and instantiate an effects file.
+std::vector<EffectPtr> loadEffectsFile(const std::string& path, const std::set<std::string>& world_surfaces = {});
 
 std::string effectsToYaml(const std::vector<EffectConfig>& configs, const std::string& header_comment = "");
 void writeEffectsFile(const std::string& path, const std::vector<EffectConfig>& configs,
