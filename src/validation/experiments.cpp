@@ -283,7 +283,7 @@ TrialWorld stepWorld(const std::string& level, double height_m, bool backward, i
   Jitter j(std::string("step") + (backward ? "b" : "f") + level, height_m, trial);
   TrialWorld t{configFor(d, 2000 + trial, drive)};
   t.world.terrain.type = TerrainConfig::Type::Composite;
-  addBlock(t.world.terrain.boxes, 0.0, 1.0, height_m, "step");
+  addBlock(t.world.terrain.boxes, 0.0, 1.0, height_m * s, "step");  // halved for Fast, as its gaps
   const double x0 = -0.075 * s + j.uniform(-0.005, 0.005) * s;
   const double yaw = (backward ? M_PI : 0.0) + j.uniform(-0.03, 0.03);
   t.start = {x0, j.uniform(-0.01, 0.01) * s, yaw};
@@ -307,7 +307,7 @@ Outcome stepTrial(const std::string& level, double height_m, bool backward, int 
     // A robot that reverses up a step nose-first onto its held gripper stands at 70-77 deg and can
     // be carried onto the step that way (its base then lies high): toppled, not passed.
     if (tilt > kToppledTilt) { o.label = "topple"; return true; }
-    if (p.x() > 0.09 * s && p.z() > z0 + height_m - 0.006 && tilt < kUprightTilt) { o.label = "pass"; return true; }
+    if (p.x() > 0.09 * s && p.z() > z0 + (height_m - 0.006) * s && tilt < kUprightTilt) { o.label = "pass"; return true; }
     return false;
   });
   o.value = r.basePose().position.x();

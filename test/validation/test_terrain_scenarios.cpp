@@ -104,5 +104,28 @@ TEST(TerrainScenarios, ATrialsWorldWrittenAsAScenarioReadsBackExactly) {
   EXPECT_EQ(written, 5) << "gap, step, stepb, uphill and downhill";
 }
 
+// The half-size Fast robot meets its terrain halved (seed 4.2.2): a cell's gap width and step height
+// are full-size values, halved in the Fast trial's world (steps kept their full height until
+// 2026-11-28, a 30 mm Fast step cell being a step taller than the half-size robot's wheels).
+TEST(TerrainScenarios, TheFastRobotsGapsAndStepsAreHalved) {
+  auto box = [](const validation::TrialWorld& t, const std::string& name) {
+    for (const BoxObstacle& b : t.world.terrain.boxes)
+      if (b.name == name) return b;
+    ADD_FAILURE() << "no box " << name;
+    return BoxObstacle{};
+  };
+  auto gapOf = [&](const validation::TrialWorld& t) {
+    const BoxObstacle near = box(t, "near_side"), far = box(t, "far_side");
+    return (far.center.x() - far.size.x() / 2) - (near.center.x() + near.size.x() / 2);
+  };
+  const validation::Drive drive;
+  EXPECT_NEAR(gapOf(validation::gapWorld("detailed", 0.04, 0, drive)), 0.04, 1e-12);
+  EXPECT_NEAR(gapOf(validation::gapWorld("fast", 0.04, 0, drive)), 0.02, 1e-12);
+  for (const bool backward : {false, true}) {
+    EXPECT_NEAR(box(validation::stepWorld("detailed", 0.016, backward, 0, drive), "step").size.z(), 0.016, 1e-12);
+    EXPECT_NEAR(box(validation::stepWorld("fast", 0.016, backward, 0, drive), "step").size.z(), 0.008, 1e-12);
+  }
+}
+
 }  // namespace
 }  // namespace sbot
