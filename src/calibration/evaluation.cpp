@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 
 namespace sbot::calib {
 
@@ -172,6 +174,73 @@ Evaluation evaluate(const Dataset& ds, const ModelSpec& model, const std::vector
   ev.runs.resize(runs.size());
   for (std::size_t k = 0; k < order.size(); ++k) ev.runs[order[k]] = std::move(res[k]);
   return ev;
+}
+
+std::vector<ReplaySensitivity> replaySensitivity(const Dataset& ds, const ModelSpec& model, const EvalOptions& opt,
+                                                 WorkerPool& pool) {
+  std::vector<int> drive;
+  for (int i = 0; i < static_cast<int>(ds.runs.size()); ++i)
+    if (ds.runs[i].kind == RunKind::Drive) drive.push_back(i);
+  ReplayOptions ro = opt.replay;
+  ro.keep_trace = false;
+  if (opt.world_override) ro.world_override = opt.world_override;
+  const double nudge_xy = kStartNudge * ds.noise.sigma("x", 0), nudge_yaw = kStartNudge * ds.noise.sigma("yaw", 0);
+  // Per run: the channels' names and their (sum of squares, count), summed over channels last.
+  using ChannelSums = std::map<std::string, std::pair<double, double>>;
+  const auto sums = pool.map<ChannelSums>(drive.size(), [&](std::size_t k) {
+    const Run& run = ds.runs[drive[k]];
+    Run nudged = run;
+    nudged.initial_pose.x += nudge_xy;
+    nudged.initial_pose.y += nudge_xy;
+    nudged.initial_pose.yaw += nudge_yaw;
+    const RunPrediction a = replayRun(ds, run, model, ro), b = replayRun(ds, nudged, model, ro);
+    ChannelSums out;
+    for (const auto& [c, pa] : a.values) {
+      const auto it = b.values.find(c);
+      if (it == b.values.end()) continue;
+      auto& [ss, n] = out[c];
+      for (std::size_t i = 0; i < pa.size() && i < it->second.size(); ++i) {
+        if (!std::isfinite(pa[i]) || !std::isfinite(it->second[i])) continue;
+        const double sigma = ds.noise.sigma(c, pa[i]);
+        if (!(sigma > 0)) continue;
+        const double d = c == "yaw" ? wrapAngle(it->second[i] - pa[i]) : it->second[i] - pa[i];
+        ss += (d / sigma) * (d / sigma);
+        n += 1;
+      }
+    }
+    return out;
+  });
+  std::vector<ReplaySensitivity> res;
+  for (std::size_t k = 0; k < drive.size(); ++k) {
+    ReplaySensitivity r;
+    r.run = drive[k];
+    double ss = 0, n = 0;
+    for (const auto& [c, v] : sums[k]) {
+      ss += v.first;
+      n += v.second;
+      const double rms = v.second > 0 ? std::sqrt(v.first / v.second) : 0.0;
+      if (rms > r.worst_nrms || r.worst_channel.empty()) {
+        r.worst_nrms = rms;
+        r.worst_channel = c;
+      }
+    }
+    r.nrms = n > 0 ? std::sqrt(ss / n) : 0.0;
+    res.push_back(r);
+  }
+  return res;
+}
+
+std::string describeChaoticRuns(const Dataset& ds, const std::vector<ReplaySensitivity>& s) {
+  std::vector<ReplaySensitivity> hit;
+  for (const auto& r : s)
+    if (r.nrms > kChaoticSensitivity) hit.push_back(r);
+  std::sort(hit.begin(), hit.end(), [](const auto& a, const auto& b) { return a.nrms > b.nrms; });
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(1);
+  for (std::size_t i = 0; i < hit.size(); ++i)
+    o << (i ? ", " : "") << ds.runs[hit[i].run].name << " " << hit[i].nrms << " (" << hit[i].worst_channel << " "
+      << hit[i].worst_nrms << ")";
+  return o.str();
 }
 
 }  // namespace sbot::calib

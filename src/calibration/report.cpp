@@ -164,6 +164,7 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
   for (std::size_t vi = 0; vi < variants.size(); ++vi) {
     Evaluation ev = evaluate(ds, variants[vi].second, allRuns(ds), eo, pool);
     sums.push_back(summarise(ds, ev, variants[vi].first, variants[vi].second));
+    sums.back().sensitivity = replaySensitivity(ds, variants[vi].second, opt.eval, pool);
     // Per-sample data and traces for the plots.
     const std::string vdir = opt.out_dir + "/data/v" + std::to_string(vi);
     makeOutputDirectory(vdir);
@@ -284,6 +285,30 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
   if (sums.size() > 1 && drawn) {
     md << "### Before / after\n\n![before and after](plots/before_after.png)\n\n"
        << "### Waterfall (effects added one by one)\n\n![waterfall](plots/waterfall.png)\n\n";
+  }
+
+  // Which residuals can be read as missing physics at all (evaluation.h, ReplaySensitivity).
+  bool any_drive = false;
+  for (const auto& s : sums) any_drive |= !s.sensitivity.empty();
+  if (any_drive) {
+    md << "## Reproducibility of the replays\n\n"
+       << "Each drive run was replayed a second time from a start moved by " << kStartNudge
+       << " of the tracker's noise (x, y, yaw). A run whose prediction then moves by more than " << kChaoticSensitivity
+       << " of the noise (nRMS) is chaotic in that model: its residual shows where the simulated trajectory "
+          "happened to go, not which physics is missing, and no effect can fit it. Leave such runs out of fits "
+          "(or drive them more gently) and read their plots, not their numbers.\n\n";
+    for (const auto& s : sums) {
+      if (s.sensitivity.empty()) continue;
+      const std::string chaotic = describeChaoticRuns(ds, s.sensitivity);
+      const auto most = std::max_element(s.sensitivity.begin(), s.sensitivity.end(),
+                                         [](const auto& a, const auto& b) { return a.nrms < b.nrms; });
+      if (chaotic.empty())
+        md << "- " << s.label << ": every drive run is reproducible (largest " << f(most->nrms, 2) << ", "
+           << ds.runs[most->run].name << ").\n";
+      else
+        md << "- " << s.label << ": **not reproducible**: " << chaotic << " (nRMS, and the channel that moved most).\n";
+    }
+    md << "\n";
   }
 
   md << "## Per run and channel\n\n";

@@ -26,6 +26,7 @@ struct VariantSummary {
   std::map<std::string, double> group_rmse;   ///< per channel group, channel units
   std::vector<ChannelMetrics> channels;   ///< per run and channel
   std::vector<std::string> notes;
+  std::vector<ReplaySensitivity> sensitivity;  ///< per drive run (compare only; evaluation.h)
 };
 
 struct CompareOptions {

@@ -333,6 +333,11 @@ int cmdCompare(const Args& a) {
   const auto sums = writeCompareReport(ds, variants, co, WorkerPool::global());
   std::printf("%-28s %-60s %10s\n", "model", "effects", "nRMS");
   for (const auto& s : sums) std::printf("%-28s %-60s %10.4f\n", s.label.c_str(), s.model.describe().c_str(), s.nrms);
+  for (const auto& s : sums)
+    if (const std::string chaotic = describeChaoticRuns(ds, s.sensitivity); !chaotic.empty())
+      std::printf("note: not reproducible under %s (a start %g of the tracker noise away moves the prediction by more "
+                  "than %g noise): %s; their residuals are not evidence of a missing effect\n",
+                  s.label.c_str(), kStartNudge, kChaoticSensitivity, chaotic.c_str());
   if (sums.size() > 1)
     std::printf("error change (nRMS): %.4f -> %.4f (%s)\n", sums.front().nrms, sums.back().nrms,
                 pct(100 * (sums.back().nrms / sums.front().nrms - 1)).c_str());
@@ -538,10 +543,22 @@ int cmdGenerate(const Args& a) {
     throw std::invalid_argument("--out " + a.get("out") + " is a folder that is not empty (a dataset written there would " +
                                 "overwrite its files and mix with the rest): remove it or choose another folder");
   checkOutputPlace("out", a.get("out"), true);
-  const Dataset ds = generateDataset(g, WorkerPool::global());
+  GeneratedTruth truth;
+  const Dataset ds = generateDataset(g, WorkerPool::global(), &truth);
   writeDataset(ds, a.get("out"));
   std::printf("wrote %s: %zu runs, %zu samples (level %s, seed %llu)\n", a.get("out").c_str(), ds.runs.size(),
               ds.sampleCount(), g.level.c_str(), static_cast<unsigned long long>(g.seed));
+  // Runs that even the true model cannot replay (evaluation.h): a dataset full of them tests nothing.
+  EvalOptions eo;
+  eo.world_override = &truth.world;
+  eo.replay.tilt = truth.tilt_deg * M_PI / 180;
+  eo.replay.tilt_direction = truth.tilt_direction;
+  const ModelSpec true_model{g.level, truth.hidden};
+  if (const std::string chaotic = describeChaoticRuns(ds, replaySensitivity(ds, true_model, eo, WorkerPool::global()));
+      !chaotic.empty())
+    std::printf("note: the true model itself does not reproduce these runs (a start %g of the tracker noise away "
+                "moves them by more than %g noise): %s; leave them out (--families) to test effects on this level\n",
+                kStartNudge, kChaoticSensitivity, chaotic.c_str());
   return 0;
 }
 
