@@ -10,6 +10,7 @@
 #include <iomanip>
 #include <regex>
 #include <sstream>
+#include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
 
@@ -236,6 +237,26 @@ std::size_t Dataset::sampleCount() const {
   std::size_t n = 0;
   for (const auto& r : runs) n += r.sampleCount();
   return n;
+}
+
+Dataset withoutRuns(const Dataset& ds, const std::set<std::string>& skip) {
+  std::set<std::string> missing = skip;
+  Dataset kept = ds;
+  kept.runs.clear();
+  for (const Run& r : ds.runs) {
+    missing.erase(r.name);
+    if (!skip.count(r.name)) kept.runs.push_back(r);
+  }
+  if (!missing.empty()) {
+    std::string names, known;
+    for (const auto& n : missing) names += (names.empty() ? "" : ", ") + n;
+    for (const Run& r : ds.runs) known += (known.empty() ? "" : ", ") + r.name;
+    throw std::invalid_argument("dataset " + ds.name + " has no run named " + names + " (its runs: " + known + ")");
+  }
+  if (kept.runs.empty())
+    throw std::invalid_argument("leaving out " + std::to_string(skip.size()) + " run(s) leaves dataset " + ds.name +
+                                " with no run");
+  return kept;
 }
 
 bool isKnownColumn(const std::string& c) {

@@ -132,6 +132,11 @@ Dataset loadDataset(const std::string& path);
 /// Parse one run file (exposed for tests).
 void parseRunCsv(const std::string& text, const std::string& file, Run& run);
 
+/// The dataset without the runs named in `skip` (e.g. runs a model cannot replay, evaluation.h
+/// ReplaySensitivity). Throws std::invalid_argument naming a run the dataset does not have, or when
+/// no run would be left.
+Dataset withoutRuns(const Dataset& ds, const std::set<std::string>& skip);
+
 /// Write a dataset (dataset.yaml + one CSV per run) into `dir` (created). Channels with different
 /// time stamps are merged into one CSV with empty cells.
 void writeDataset(const Dataset& ds, const std::string& dir);

@@ -243,4 +243,11 @@ std::string describeChaoticRuns(const Dataset& ds, const std::vector<ReplaySensi
   return o.str();
 }
 
+std::set<std::string> chaoticRunNames(const Dataset& ds, const std::vector<ReplaySensitivity>& s) {
+  std::set<std::string> names;
+  for (const auto& r : s)
+    if (r.nrms > kChaoticSensitivity) names.insert(ds.runs[r.run].name);
+  return names;
+}
+
 }  // namespace sbot::calib

@@ -293,10 +293,10 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
   if (any_drive) {
     md << "## Reproducibility of the replays\n\n"
        << "Each drive run was replayed a second time from a start moved by " << kStartNudge
-       << " of the tracker's noise (x, y, yaw). A run whose prediction then moves by more than " << kChaoticSensitivity
+       << " sigma of the tracker's noise (x, y, yaw). A run whose prediction then moves by more than " << kChaoticSensitivity
        << " of the noise (nRMS) is chaotic in that model: its residual shows where the simulated trajectory "
           "happened to go, not which physics is missing, and no effect can fit it. Leave such runs out of fits "
-          "(or drive them more gently) and read their plots, not their numbers.\n\n";
+          "(`diagnose`/`fit --skip-chaotic`, or drive them more gently) and read their plots, not their numbers.\n\n";
     for (const auto& s : sums) {
       if (s.sensitivity.empty()) continue;
       const std::string chaotic = describeChaoticRuns(ds, s.sensitivity);

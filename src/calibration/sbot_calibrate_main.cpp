@@ -9,7 +9,8 @@
 //   sbot_calibrate sweep    [--out FILE.md] [--seeds N] [--cases a,b] [--level L] [--duration S] [--set name:p=v]
 //   sbot_calibrate effects  (list the effects library)
 //   common: --jobs N (worker processes, default: all cores), --quiet; compare/diagnose/fit also
-//           --solver quickstep|exact (replaces the dataset's world stepper)
+//           --solver quickstep|exact (replaces the dataset's world stepper) and --skip-runs a,b;
+//           diagnose/fit/sweep also --skip-chaotic (leaves out the runs the start model cannot replay)
 // Output places (--out, --write-effects) are created and checked before the work: a fit or a
 // diagnosis runs for minutes, and its result must not be lost to an unwritable path at the end. They
 // are checked after the input (dataset, effects, option values), so a refused run creates no folder.
@@ -96,18 +97,20 @@ struct UnknownCommand : std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
-const std::set<std::string> kFlags{"no-plots", "quiet", "no-align", "torque", "no-tilt", "no-speed", "verbose", "help"};
+const std::set<std::string> kFlags{"no-plots", "quiet",   "no-align",     "torque", "no-tilt",
+                                   "no-speed", "verbose", "skip-chaotic", "help"};
 
 /// The options each subcommand reads (besides --jobs, --quiet, --help). Anything else is refused:
 /// a misspelt option would otherwise be ignored, e.g. `compare --effect F` comparing the nominal model.
 const std::map<std::string, std::set<std::string>> kCommandOptions{
-    {"compare", {"effects", "level", "solver", "out", "no-plots", "no-align"}},
-    {"diagnose", {"effects", "level", "solver", "folds", "threshold", "seed", "candidates", "write-effects", "verbose"}},
-    {"fit", {"effect", "effects", "level", "solver", "out", "max-iterations"}},
+    {"compare", {"effects", "level", "solver", "out", "no-plots", "no-align", "skip-runs"}},
+    {"diagnose", {"effects", "level", "solver", "folds", "threshold", "seed", "candidates", "write-effects", "verbose",
+                  "skip-runs", "skip-chaotic"}},
+    {"fit", {"effect", "effects", "level", "solver", "out", "max-iterations", "skip-runs", "skip-chaotic"}},
     {"generate", {"out", "level", "solver", "seed", "duration", "tilt", "repeat", "max-runs", "name", "torque",
                   "no-tilt", "no-speed", "families", "hidden", "hide"}},
     {"sweep", {"cases", "set", "seeds", "first-seed", "level", "solver", "duration", "folds", "threshold", "torque",
-               "out"}},
+               "skip-chaotic", "out"}},
     {"effects", {}}};
 
 /// Refuse an option the subcommand does not read (a misspelt one would otherwise be ignored).
@@ -267,10 +270,12 @@ void usage() {
                "           [--tilt DEG] [--duration S] [--families straight,spin,arc,square,steps,place,approach] [--repeat N]\n"
                "           [--max-runs N] [--name NAME] [--torque] [--no-tilt] [--no-speed]\n"
                "  sweep    [--out FILE.md] [--seeds N] [--cases a,b] [--level L] [--solver S] [--duration S]\n"
-               "           [--set name:p=v+name2:p=v]  (another magnitude for the cases that hide those effects)\n"
+               "           [--set name:p=v+name2:p=v]  (another magnitude for the cases that hide those effects) [--skip-chaotic]\n"
                "  effects  list the effects library\n"
                "common options: --jobs N (worker processes; default all cores), --quiet;\n"
-               "  compare/diagnose/fit: --solver quickstep|exact replaces the dataset's world stepper\n");
+               "  compare/diagnose/fit: --solver quickstep|exact replaces the dataset's world stepper,\n"
+               "    --skip-runs a,b leaves those runs out; diagnose/fit/sweep: --skip-chaotic leaves out the runs the start\n"
+               "    model does not reproduce (named either way)\n");
 }
 
 /// --solver (the world's stepper), checked.
@@ -285,6 +290,10 @@ std::string solverOption(const Args& a, const std::string& def) {
 Dataset datasetFor(const Args& a) {
   Dataset ds = loadDataset(a.positional[0]);
   if (a.has("solver")) ds.world.solver = solverOption(a, "");
+  if (a.has("skip-runs")) {
+    const auto names = splitList(a.get("skip-runs"), ',');
+    ds = withoutRuns(ds, std::set<std::string>(names.begin(), names.end()));
+  }
   return ds;
 }
 
@@ -299,6 +308,26 @@ ModelSpec baseModel(const Dataset& ds, const Args& a) {
   loadLevel(m.level);  // an unknown level is named now, not by the first replay
   if (a.has("effects")) m.effects = effectsOption(ds, a);
   return m;
+}
+
+/// The runs the start model can replay from its own start (evaluation.h, ReplaySensitivity): fitting
+/// the others fits where a chaotic trajectory happened to go. Named always; left out with
+/// --skip-chaotic.
+Dataset replayableRuns(const Dataset& ds, const ModelSpec& start, const Args& a) {
+  const auto sens = replaySensitivity(ds, start, EvalOptions(), WorkerPool::global());
+  const std::string chaotic = describeChaoticRuns(ds, sens);
+  if (chaotic.empty()) return ds;
+  if (!a.has("skip-chaotic")) {
+    std::printf("note: the start model does not reproduce these runs (a start %g sigma of the tracker noise away moves them "
+                "by more than %g noise): %s; their residuals are not evidence of a missing effect: --skip-chaotic "
+                "leaves them out\n",
+                kStartNudge, kChaoticSensitivity, chaotic.c_str());
+    return ds;
+  }
+  const std::set<std::string> skip = chaoticRunNames(ds, sens);
+  std::printf("--skip-chaotic: leaving out %zu run%s the start model does not reproduce: %s\n", skip.size(),
+              skip.size() == 1 ? "" : "s", chaotic.c_str());
+  return withoutRuns(ds, skip);
 }
 
 int cmdEffects() {
@@ -335,7 +364,7 @@ int cmdCompare(const Args& a) {
   for (const auto& s : sums) std::printf("%-28s %-60s %10.4f\n", s.label.c_str(), s.model.describe().c_str(), s.nrms);
   for (const auto& s : sums)
     if (const std::string chaotic = describeChaoticRuns(ds, s.sensitivity); !chaotic.empty())
-      std::printf("note: not reproducible under %s (a start %g of the tracker noise away moves the prediction by more "
+      std::printf("note: not reproducible under %s (a start %g sigma of the tracker noise away moves the prediction by more "
                   "than %g noise): %s; their residuals are not evidence of a missing effect\n",
                   s.label.c_str(), kStartNudge, kChaoticSensitivity, chaotic.c_str());
   if (sums.size() > 1)
@@ -382,16 +411,19 @@ void printSkippedCandidates(const Dataset& ds) {
 
 int cmdDiagnose(const Args& a) {
   if (a.positional.empty()) throw std::invalid_argument("diagnose needs a DATASET");
-  const Dataset ds = datasetFor(a);
   DiagnoseOptions o;
-  o.base = baseModel(ds, a);
+  const Dataset measured = datasetFor(a);
+  o.base = baseModel(measured, a);
   o.folds = static_cast<int>(a.whole("folds", 2, 2, INT_MAX, "each fold's runs are scored by a fit on the others"));
   o.bic_threshold = a.num("threshold", 10);
   o.seed = static_cast<std::uint64_t>(a.whole("seed", 1, 0, LLONG_MAX));
-  if (a.has("candidates")) o.candidates = namedCandidates(ds, a);
+  if (a.has("candidates")) o.candidates = namedCandidates(measured, a);
   o.progress = !a.has("quiet");
   if (a.has("verbose")) o.log = [](const std::string& s) { std::fprintf(stderr, "%s\n", s.c_str()); };
   if (a.has("write-effects")) checkOutputPlace("write-effects", a.get("write-effects"), false);
+  const Dataset ds = replayableRuns(measured, o.base, a);
+  // The runs left must still measure what the named candidates act on.
+  if (a.has("candidates") && ds.runs.size() < measured.runs.size()) o.candidates = namedCandidates(ds, a);
   WorkerPool& pool = WorkerPool::global();
   const int folds = foldCount(ds, o.folds);
   std::printf("diagnose %s: %zu runs, %zu samples, level %s, %d fold%s, %d worker process%s\n", ds.name.c_str(),
@@ -449,18 +481,20 @@ int cmdFit(const Args& a) {
     }
   if (names.empty()) throw std::invalid_argument("fit needs --effect NAME");
   if (!a.has("out")) throw std::invalid_argument("fit needs --out FILE (the effects file to write)");
-  const Dataset ds = datasetFor(a);
-  ModelSpec m = baseModel(ds, a);
+  const Dataset measured = datasetFor(a);
+  ModelSpec m = baseModel(measured, a);
+  const ModelSpec start = m;
   std::vector<int> idx;
   for (const auto& n : names) {
-    if (const std::string why = unmeasuredChannels(ds, n); !why.empty())
+    if (const std::string why = unmeasuredChannels(measured, n); !why.empty())
       throw std::invalid_argument("--effect: " + why + ": there is nothing to fit it to");
     int at = -1;
     for (std::size_t i = 0; i < m.effects.size(); ++i)
       if (m.effects[i].name == n) at = static_cast<int>(i);
     if (at < 0) {
       // As diagnose does: per-surface parameters for the surfaces of the dataset's obstacles.
-      m.effects.push_back(EffectRegistry::instance().info(n).open_params ? candidateConfig(ds, n) : EffectConfig{n, {}, {}, ""});
+      m.effects.push_back(EffectRegistry::instance().info(n).open_params ? candidateConfig(measured, n)
+                                                                         : EffectConfig{n, {}, {}, ""});
       at = static_cast<int>(m.effects.size()) - 1;
     }
     if (freeParamsOf(m, {at}).empty())
@@ -469,9 +503,13 @@ int cmdFit(const Args& a) {
                                   "effects: [{name: " + n + ", params: {white_paper: 1, black_card: 1}}]");
     idx.push_back(at);
   }
-  checkOutputPlace("out", a.get("out"), false);
   FitOptions fo;
   fo.max_iterations = static_cast<int>(a.whole("max-iterations", fo.max_iterations, 1, 1000, "Levenberg-Marquardt iterations"));
+  checkOutputPlace("out", a.get("out"), false);
+  const Dataset ds = replayableRuns(measured, start, a);
+  for (const auto& n : names)
+    if (const std::string why = unmeasuredChannels(ds, n); !why.empty())
+      throw std::invalid_argument("--effect: " + why + " in the runs left: there is nothing to fit it to");
   WorkerPool& pool = WorkerPool::global();
   std::size_t evals = 0;
   const bool quiet = a.has("quiet");
@@ -556,7 +594,7 @@ int cmdGenerate(const Args& a) {
   const ModelSpec true_model{g.level, truth.hidden};
   if (const std::string chaotic = describeChaoticRuns(ds, replaySensitivity(ds, true_model, eo, WorkerPool::global()));
       !chaotic.empty())
-    std::printf("note: the true model itself does not reproduce these runs (a start %g of the tracker noise away "
+    std::printf("note: the true model itself does not reproduce these runs (a start %g sigma of the tracker noise away "
                 "moves them by more than %g noise): %s; leave them out (--families) to test effects on this level\n",
                 kStartNudge, kChaoticSensitivity, chaotic.c_str());
   return 0;
@@ -574,6 +612,7 @@ int cmdSweep(const Args& a) {
   o.first_seed = static_cast<std::uint64_t>(a.whole("first-seed", 1, 0, LLONG_MAX));
   o.diag.folds = static_cast<int>(a.whole("folds", 2, 2, INT_MAX, "each fold's runs are scored by a fit on the others"));
   o.diag.bic_threshold = a.num("threshold", 10);
+  o.skip_chaotic = a.has("skip-chaotic");
   o.progress = !a.has("quiet");
   std::vector<std::string> names;
   if (a.has("cases")) {

@@ -75,6 +75,7 @@ void save(Writer& w, const SeedOutcome& o) {
   save(w, o.structure_flagged);
   save(w, o.seconds);
   save(w, o.verdict);
+  save(w, o.left_out);
 }
 void load(Reader& r, SeedOutcome& o) {
   load(r, o.seed);
@@ -91,6 +92,7 @@ void load(Reader& r, SeedOutcome& o) {
   load(r, o.structure_flagged);
   load(r, o.seconds);
   load(r, o.verdict);
+  load(r, o.left_out);
 }
 
 std::vector<SweepCase> standardCases(const std::string&) {
@@ -168,11 +170,16 @@ std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool) {
     g.tilt_deg = sc.tilt_deg;
     g.name = sc.name;
     GeneratedTruth truth;
-    const Dataset ds = generateDataset(g, pool, &truth);
+    Dataset ds = generateDataset(g, pool, &truth);
     DiagnoseOptions d = opt.diag;
     d.progress = false;
     d.seed = o.seed;
     d.base.level = g.level;
+    if (opt.skip_chaotic) {
+      const auto chaotic = chaoticRunNames(ds, replaySensitivity(ds, d.base, d.fit.eval, pool));
+      o.left_out.assign(chaotic.begin(), chaotic.end());
+      ds = withoutRuns(ds, chaotic);
+    }
     const auto ts = std::chrono::steady_clock::now();
     const DiagnoseResult r = diagnose(ds, d, pool);
     o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ts).count();
@@ -257,7 +264,9 @@ std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions&
   std::ostringstream md;
   md << "Sweep: " << opt.seeds << (opt.seeds == 1 ? " seed" : " seeds") << " per case, level " << opt.gen.level << " (unless the case names one), drive patterns of "
      << opt.gen.duration << " s, solver " << opt.gen.solver << ", " << opt.diag.folds << "-fold split by run, acceptance dBIC > "
-     << opt.diag.bic_threshold << "; " << std::fixed << std::setprecision(0) << seconds << " s wall.\n\n";
+     << opt.diag.bic_threshold
+     << (opt.skip_chaotic ? "; runs the starting model does not replay reproducibly left out (--skip-chaotic)" : "")
+     << "; " << std::fixed << std::setprecision(0) << seconds << " s wall.\n\n";
   md << "| hidden | truth | right first | params +-10 % | held-out RMS -50 % | ends <= 1.2x floor | failing channels -50 % | "
         "failing channels <= 1.2x floor | nothing accepted | structure flagged | both found | s/diagnose |\n"
         "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -294,6 +303,7 @@ std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions&
         if (it != o.estimate.end()) md << key << "=" << std::setprecision(4) << it->second << " ";
       }
       md << std::setprecision(2) << o.rms_before << "->" << o.rms_after << " (" << o.floor << ")";
+      if (!o.left_out.empty()) md << " without " << o.left_out.size() << " run" << (o.left_out.size() == 1 ? "" : "s");
       if (!o.failing_channels.empty()) {
         std::string ch;
         for (const auto& x : o.failing_channels) ch += (ch.empty() ? "" : ",") + x;

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
 
 #include "../common/run_process.h"
 
@@ -307,6 +308,39 @@ TEST(Cli, AnEffectsFileWithAnUnknownSurfaceOrStderrKeyIsRefused) {
   EXPECT_EQ(err.status, 1) << err.output;
   EXPECT_TRUE(contains(err.output, dir + "stderr.yaml: field 'effects[0].stderr.dely': a standard error for 'dely', which params does not give (params: delay)"))
       << err.output;
+}
+
+// A Fast robot (1/50 g) tips over in the generator's arcs, so even the true model cannot replay them
+// from a start one sigma of the tracker noise away (evaluation.h, ReplaySensitivity): generate, fit and
+// diagnose name them, --skip-chaotic leaves them out, and --skip-runs leaves out runs by name.
+TEST(Cli, RunsTheModelCannotReplayAreNamedAndCanBeLeftOut) {
+  // The command ends with `status` and prints every one of `parts`.
+  auto expectRun = [](const std::string& args, int status, const std::vector<std::string>& parts) {
+    const Outcome o = run(args);
+    EXPECT_EQ(o.status, status) << args << ": " << o.output;
+    for (const auto& p : parts) EXPECT_TRUE(contains(o.output, p)) << args << ": no '" << p << "' in " << o.output;
+    return o.output;
+  };
+  const std::string dir = freshDir("cli_chaotic");
+  expectRun("generate --out " + dir + "fast --level fast --seed 3 --families straight,arc --quiet", 0,
+            {"note: the true model itself does not reproduce these runs", "arc_"});
+  const std::string fit = "fit " + dir + "fast --effect speed_scale --quiet --max-iterations 2 --out " + dir;
+  // straight_20/40/60 and the two arcs.
+  expectRun(fit + "noted.yaml", 0, {"note: the start model does not reproduce these runs", "fit on 5 runs"});
+  const std::string skipped =
+      expectRun(fit + "skipped.yaml --skip-chaotic", 0, {"--skip-chaotic: leaving out ", "arc_right", "fit on "});
+  EXPECT_FALSE(contains(skipped, "fit on 5 runs")) << skipped;
+  const std::string named = expectRun(fit + "named.yaml --skip-runs arc_left,arc_right", 0, {"fit on 3 runs"});
+  EXPECT_FALSE(contains(named, "note: the start model does not reproduce")) << named;
+  expectRun("compare " + dir + "fast --no-plots --quiet --skip-runs arc_left,spiral --out " + dir + "c", 1,
+            {"has no run named spiral (its runs: "});
+  expectRun(fit + "all.yaml --skip-runs arc_left,arc_right,straight_20,straight_40,straight_60", 1, {"leaves dataset"});
+  EXPECT_FALSE(exists(dir + "all.yaml"));
+  // sweep --skip-chaotic diagnoses each synthetic dataset without those runs, and says how many.
+  expectRun("sweep --quiet --level fast --cases none --seeds 1 --skip-chaotic", 0,
+            {"left out (--skip-chaotic)", ") without "});
+  expectRun("compare " + dir + "fast --no-plots --skip-chaotic --out " + dir + "c", 1,
+            {"unknown option --skip-chaotic for 'compare'"});
 }
 
 TEST(Cli, TheOptionsItTakesAreAccepted) {

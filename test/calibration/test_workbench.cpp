@@ -90,7 +90,7 @@ TEST(Generator, TrueModelSitsAtTheNoiseFloorAndTheNominalDoesNot) {
 
 // A run the model cannot replay from its own start is named, so that its residual is not read as a
 // missing effect: the Fast robot (1/50 g) tips over in a 30/55-unit arc, which makes its replay
-// depend on a start 1/100 of the tracker noise away; driving straight at 20 units it does not.
+// depend on where within the tracker noise its start lies; driving straight at 20 units it does not.
 TEST(ReplaySensitivity, NamesTheRunsEvenTheTrueModelCannotReproduce) {
   GeneratorOptions g;
   g.level = "fast";
