@@ -243,11 +243,23 @@ std::string describeChaoticRuns(const Dataset& ds, const std::vector<ReplaySensi
   return o.str();
 }
 
-std::set<std::string> chaoticRunNames(const Dataset& ds, const std::vector<ReplaySensitivity>& s) {
-  std::set<std::string> names;
-  for (const auto& r : s)
-    if (r.nrms > kChaoticSensitivity) names.insert(ds.runs[r.run].name);
-  return names;
+ReplayableRuns replayableRuns(const Dataset& ds, const ModelSpec& model, const EvalOptions& opt, WorkerPool& pool) {
+  const std::vector<ReplaySensitivity> sens = replaySensitivity(ds, model, opt, pool);
+  std::set<int> chaotic;
+  for (const auto& r : sens)
+    if (r.nrms > kChaoticSensitivity) chaotic.insert(r.run);
+  ReplayableRuns out;
+  out.chaotic = describeChaoticRuns(ds, sens);
+  out.all_chaotic = !chaotic.empty() && chaotic.size() == ds.runs.size();
+  out.dataset = ds;
+  if (chaotic.empty() || out.all_chaotic) return out;
+  out.dataset.runs.clear();
+  for (int i = 0; i < static_cast<int>(ds.runs.size()); ++i)
+    if (chaotic.count(i))
+      out.left_out.push_back(ds.runs[i].name);
+    else
+      out.dataset.runs.push_back(ds.runs[i]);
+  return out;
 }
 
 }  // namespace sbot::calib

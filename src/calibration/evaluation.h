@@ -101,7 +101,15 @@ std::vector<ReplaySensitivity> replaySensitivity(const Dataset& ds, const ModelS
 /// The runs above kChaoticSensitivity, most sensitive first, e.g. "arc_left 21 (yaw 40)"; empty if none.
 std::string describeChaoticRuns(const Dataset& ds, const std::vector<ReplaySensitivity>& s);
 
-/// The names of the runs above kChaoticSensitivity (to leave out: dataset.h withoutRuns).
-std::set<std::string> chaoticRunNames(const Dataset& ds, const std::vector<ReplaySensitivity>& s);
+/// A dataset split by replaySensitivity: what a fit can use, and the runs it cannot.
+struct ReplayableRuns {
+  Dataset dataset;                    ///< ds without the chaotic runs (ds whole if every run is chaotic)
+  std::vector<std::string> left_out;  ///< the chaotic runs taken out of `dataset`, in dataset order
+  std::string chaotic;                ///< describeChaoticRuns of every chaotic run; empty if none
+  bool all_chaotic = false;           ///< every run is: nothing would be left to fit, so `dataset` keeps them
+};
+/// The runs `model` replays reproducibly from its own start (what diagnose, fit and sweep fit by
+/// default; their --keep-chaotic keeps every run).
+ReplayableRuns replayableRuns(const Dataset& ds, const ModelSpec& model, const EvalOptions& opt, WorkerPool& pool);
 
 }  // namespace sbot::calib

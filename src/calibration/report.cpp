@@ -295,8 +295,9 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
        << "Each drive run was replayed a second time from a start moved by " << kStartNudge
        << " sigma of the tracker's noise (x, y, yaw). A run whose prediction then moves by more than " << kChaoticSensitivity
        << " of the noise (nRMS) is chaotic in that model: its residual shows where the simulated trajectory "
-          "happened to go, not which physics is missing, and no effect can fit it. Leave such runs out of fits "
-          "(`diagnose`/`fit --skip-chaotic`, or drive them more gently) and read their plots, not their numbers.\n\n";
+          "happened to go, not which physics is missing, and no effect can fit it. `diagnose` and `fit` leave such "
+          "runs out (unless --keep-chaotic); drive them more gently to test them, and read their plots, not their "
+          "numbers.\n\n";
     for (const auto& s : sums) {
       if (s.sensitivity.empty()) continue;
       const std::string chaotic = describeChaoticRuns(ds, s.sensitivity);

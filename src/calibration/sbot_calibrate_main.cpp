@@ -10,7 +10,7 @@
 //   sbot_calibrate effects  (list the effects library)
 //   common: --jobs N (worker processes, default: all cores), --quiet; compare/diagnose/fit also
 //           --solver quickstep|exact (replaces the dataset's world stepper) and --skip-runs a,b;
-//           diagnose/fit/sweep also --skip-chaotic (leaves out the runs the start model cannot replay)
+//           diagnose/fit/sweep leave out the runs the start model cannot replay (--keep-chaotic keeps them)
 // Output places (--out, --write-effects) are created and checked before the work: a fit or a
 // diagnosis runs for minutes, and its result must not be lost to an unwritable path at the end. They
 // are checked after the input (dataset, effects, option values), so a refused run creates no folder.
@@ -98,19 +98,19 @@ struct UnknownCommand : std::invalid_argument {
 };
 
 const std::set<std::string> kFlags{"no-plots", "quiet",   "no-align",     "torque", "no-tilt",
-                                   "no-speed", "verbose", "skip-chaotic", "help"};
+                                   "no-speed", "verbose", "keep-chaotic", "help"};
 
 /// The options each subcommand reads (besides --jobs, --quiet, --help). Anything else is refused:
 /// a misspelt option would otherwise be ignored, e.g. `compare --effect F` comparing the nominal model.
 const std::map<std::string, std::set<std::string>> kCommandOptions{
     {"compare", {"effects", "level", "solver", "out", "no-plots", "no-align", "skip-runs"}},
     {"diagnose", {"effects", "level", "solver", "folds", "threshold", "seed", "candidates", "write-effects", "verbose",
-                  "skip-runs", "skip-chaotic"}},
-    {"fit", {"effect", "effects", "level", "solver", "out", "max-iterations", "skip-runs", "skip-chaotic"}},
+                  "skip-runs", "keep-chaotic"}},
+    {"fit", {"effect", "effects", "level", "solver", "out", "max-iterations", "skip-runs", "keep-chaotic"}},
     {"generate", {"out", "level", "solver", "seed", "duration", "tilt", "repeat", "max-runs", "name", "torque",
                   "no-tilt", "no-speed", "families", "hidden", "hide"}},
     {"sweep", {"cases", "set", "seeds", "first-seed", "level", "solver", "duration", "folds", "threshold", "torque",
-               "skip-chaotic", "out"}},
+               "keep-chaotic", "out"}},
     {"effects", {}}};
 
 /// Refuse an option the subcommand does not read (a misspelt one would otherwise be ignored).
@@ -270,12 +270,12 @@ void usage() {
                "           [--tilt DEG] [--duration S] [--families straight,spin,arc,square,steps,place,approach] [--repeat N]\n"
                "           [--max-runs N] [--name NAME] [--torque] [--no-tilt] [--no-speed]\n"
                "  sweep    [--out FILE.md] [--seeds N] [--cases a,b] [--level L] [--solver S] [--duration S]\n"
-               "           [--set name:p=v+name2:p=v]  (another magnitude for the cases that hide those effects) [--skip-chaotic]\n"
+               "           [--set name:p=v+name2:p=v]  (another magnitude for the cases that hide those effects) [--keep-chaotic]\n"
                "  effects  list the effects library\n"
                "common options: --jobs N (worker processes; default all cores), --quiet;\n"
                "  compare/diagnose/fit: --solver quickstep|exact replaces the dataset's world stepper,\n"
-               "    --skip-runs a,b leaves those runs out; diagnose/fit/sweep: --skip-chaotic leaves out the runs the start\n"
-               "    model does not reproduce (named either way)\n");
+               "    --skip-runs a,b leaves those runs out; diagnose/fit/sweep leave out the runs the start model does\n"
+               "    not reproduce (named; --keep-chaotic keeps them)\n");
 }
 
 /// --solver (the world's stepper), checked.
@@ -311,23 +311,21 @@ ModelSpec baseModel(const Dataset& ds, const Args& a) {
 }
 
 /// The runs the start model can replay from its own start (evaluation.h, ReplaySensitivity): fitting
-/// the others fits where a chaotic trajectory happened to go. Named always; left out with
-/// --skip-chaotic.
-Dataset replayableRuns(const Dataset& ds, const ModelSpec& start, const Args& a) {
-  const auto sens = replaySensitivity(ds, start, EvalOptions(), WorkerPool::global());
-  const std::string chaotic = describeChaoticRuns(ds, sens);
-  if (chaotic.empty()) return ds;
-  if (!a.has("skip-chaotic")) {
+/// the others fits where a chaotic trajectory happened to go. Named always; kept with --keep-chaotic.
+Dataset runsToFit(const Dataset& ds, const ModelSpec& start, const Args& a) {
+  const ReplayableRuns r = replayableRuns(ds, start, EvalOptions(), WorkerPool::global());
+  if (r.chaotic.empty()) return ds;
+  if (a.has("keep-chaotic") || r.all_chaotic) {
     std::printf("note: the start model does not reproduce these runs (a start %g sigma of the tracker noise away moves them "
-                "by more than %g noise): %s; their residuals are not evidence of a missing effect: --skip-chaotic "
-                "leaves them out\n",
-                kStartNudge, kChaoticSensitivity, chaotic.c_str());
+                "by more than %g noise): %s; their residuals are not evidence of a missing effect; kept (%s)\n",
+                kStartNudge, kChaoticSensitivity, r.chaotic.c_str(),
+                r.all_chaotic ? "every run is: nothing would be left to fit" : "--keep-chaotic");
     return ds;
   }
-  const std::set<std::string> skip = chaoticRunNames(ds, sens);
-  std::printf("--skip-chaotic: leaving out %zu run%s the start model does not reproduce: %s\n", skip.size(),
-              skip.size() == 1 ? "" : "s", chaotic.c_str());
-  return withoutRuns(ds, skip);
+  std::printf("leaving out %zu run%s the start model does not reproduce (a start %g sigma of the tracker noise away moves "
+              "them by more than %g noise; --keep-chaotic keeps them): %s\n",
+              r.left_out.size(), r.left_out.size() == 1 ? "" : "s", kStartNudge, kChaoticSensitivity, r.chaotic.c_str());
+  return r.dataset;
 }
 
 int cmdEffects() {
@@ -421,7 +419,7 @@ int cmdDiagnose(const Args& a) {
   o.progress = !a.has("quiet");
   if (a.has("verbose")) o.log = [](const std::string& s) { std::fprintf(stderr, "%s\n", s.c_str()); };
   if (a.has("write-effects")) checkOutputPlace("write-effects", a.get("write-effects"), false);
-  const Dataset ds = replayableRuns(measured, o.base, a);
+  const Dataset ds = runsToFit(measured, o.base, a);
   // The runs left must still measure what the named candidates act on.
   if (a.has("candidates") && ds.runs.size() < measured.runs.size()) o.candidates = namedCandidates(ds, a);
   WorkerPool& pool = WorkerPool::global();
@@ -506,7 +504,7 @@ int cmdFit(const Args& a) {
   FitOptions fo;
   fo.max_iterations = static_cast<int>(a.whole("max-iterations", fo.max_iterations, 1, 1000, "Levenberg-Marquardt iterations"));
   checkOutputPlace("out", a.get("out"), false);
-  const Dataset ds = replayableRuns(measured, start, a);
+  const Dataset ds = runsToFit(measured, start, a);
   for (const auto& n : names)
     if (const std::string why = unmeasuredChannels(ds, n); !why.empty())
       throw std::invalid_argument("--effect: " + why + " in the runs left: there is nothing to fit it to");
@@ -612,7 +610,7 @@ int cmdSweep(const Args& a) {
   o.first_seed = static_cast<std::uint64_t>(a.whole("first-seed", 1, 0, LLONG_MAX));
   o.diag.folds = static_cast<int>(a.whole("folds", 2, 2, INT_MAX, "each fold's runs are scored by a fit on the others"));
   o.diag.bic_threshold = a.num("threshold", 10);
-  o.skip_chaotic = a.has("skip-chaotic");
+  o.keep_chaotic = a.has("keep-chaotic");
   o.progress = !a.has("quiet");
   std::vector<std::string> names;
   if (a.has("cases")) {

@@ -175,10 +175,10 @@ std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool) {
     d.progress = false;
     d.seed = o.seed;
     d.base.level = g.level;
-    if (opt.skip_chaotic) {
-      const auto chaotic = chaoticRunNames(ds, replaySensitivity(ds, d.base, d.fit.eval, pool));
-      o.left_out.assign(chaotic.begin(), chaotic.end());
-      ds = withoutRuns(ds, chaotic);
+    if (!opt.keep_chaotic) {
+      ReplayableRuns kept = replayableRuns(ds, d.base, d.fit.eval, pool);
+      o.left_out = kept.left_out;
+      ds = std::move(kept.dataset);
     }
     const auto ts = std::chrono::steady_clock::now();
     const DiagnoseResult r = diagnose(ds, d, pool);
@@ -265,7 +265,8 @@ std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions&
   md << "Sweep: " << opt.seeds << (opt.seeds == 1 ? " seed" : " seeds") << " per case, level " << opt.gen.level << " (unless the case names one), drive patterns of "
      << opt.gen.duration << " s, solver " << opt.gen.solver << ", " << opt.diag.folds << "-fold split by run, acceptance dBIC > "
      << opt.diag.bic_threshold
-     << (opt.skip_chaotic ? "; runs the starting model does not replay reproducibly left out (--skip-chaotic)" : "")
+     << (opt.keep_chaotic ? "; every run kept, also those the starting model does not replay reproducibly (--keep-chaotic)"
+                          : "; runs the starting model does not replay reproducibly left out")
      << "; " << std::fixed << std::setprecision(0) << seconds << " s wall.\n\n";
   md << "| hidden | truth | right first | params +-10 % | held-out RMS -50 % | ends <= 1.2x floor | failing channels -50 % | "
         "failing channels <= 1.2x floor | nothing accepted | structure flagged | both found | s/diagnose |\n"

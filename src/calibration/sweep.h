@@ -36,7 +36,7 @@ struct SeedOutcome {
   bool structure_flagged = false;
   double seconds = 0;
   std::string verdict;
-  std::vector<std::string> left_out;  ///< runs the starting model could not replay (SweepOptions::skip_chaotic)
+  std::vector<std::string> left_out;  ///< runs the starting model could not replay, left out (not with keep_chaotic)
 };
 
 struct CaseSummary {
@@ -64,9 +64,10 @@ struct SweepOptions {
   std::uint64_t first_seed = 1;
   GeneratorOptions gen;          ///< level, duration, families (hidden/seed/tilt set per case)
   DiagnoseOptions diag;
-  /// Diagnose only the runs the starting model replays reproducibly (evaluation.h
-  /// ReplaySensitivity; diagnose --skip-chaotic). The noise floor is then the true model's on them.
-  bool skip_chaotic = false;
+  /// Diagnose every run, also those the starting model does not replay reproducibly (--keep-chaotic).
+  /// By default they are left out, as diagnose does (evaluation.h replayableRuns), and the noise floor
+  /// is the true model's on the runs kept.
+  bool keep_chaotic = false;
   bool progress = false;
 };
 

@@ -312,8 +312,8 @@ TEST(Cli, AnEffectsFileWithAnUnknownSurfaceOrStderrKeyIsRefused) {
 
 // A Fast robot (1/50 g) tips over in the generator's arcs, so even the true model cannot replay them
 // from a start one sigma of the tracker noise away (evaluation.h, ReplaySensitivity): generate, fit and
-// diagnose name them, --skip-chaotic leaves them out, and --skip-runs leaves out runs by name.
-TEST(Cli, RunsTheModelCannotReplayAreNamedAndCanBeLeftOut) {
+// diagnose name them, fit leaves them out unless --keep-chaotic, and --skip-runs leaves out runs by name.
+TEST(Cli, RunsTheModelCannotReplayAreNamedAndLeftOut) {
   // The command ends with `status` and prints every one of `parts`.
   auto expectRun = [](const std::string& args, int status, const std::vector<std::string>& parts) {
     const Outcome o = run(args);
@@ -326,21 +326,25 @@ TEST(Cli, RunsTheModelCannotReplayAreNamedAndCanBeLeftOut) {
             {"note: the true model itself does not reproduce these runs", "arc_"});
   const std::string fit = "fit " + dir + "fast --effect speed_scale --quiet --max-iterations 2 --out " + dir;
   // straight_20/40/60 and the two arcs.
-  expectRun(fit + "noted.yaml", 0, {"note: the start model does not reproduce these runs", "fit on 5 runs"});
-  const std::string skipped =
-      expectRun(fit + "skipped.yaml --skip-chaotic", 0, {"--skip-chaotic: leaving out ", "arc_right", "fit on "});
+  const std::string skipped = expectRun(fit + "skipped.yaml", 0, {"leaving out ", "arc_right", "fit on "});
   EXPECT_FALSE(contains(skipped, "fit on 5 runs")) << skipped;
+  expectRun(fit + "kept.yaml --keep-chaotic", 0,
+            {"note: the start model does not reproduce these runs", "kept (--keep-chaotic)", "fit on 5 runs"});
   const std::string named = expectRun(fit + "named.yaml --skip-runs arc_left,arc_right", 0, {"fit on 3 runs"});
-  EXPECT_FALSE(contains(named, "note: the start model does not reproduce")) << named;
+  EXPECT_FALSE(contains(named, "does not reproduce")) << named;
+  // Only chaotic runs: nothing would be left, so they are kept, and that is said.
+  expectRun(fit + "arcs.yaml --skip-runs straight_20,straight_40,straight_60", 0,
+            {"kept (every run is: nothing would be left to fit)", "fit on 2 runs"});
   expectRun("compare " + dir + "fast --no-plots --quiet --skip-runs arc_left,spiral --out " + dir + "c", 1,
             {"has no run named spiral (its runs: "});
   expectRun(fit + "all.yaml --skip-runs arc_left,arc_right,straight_20,straight_40,straight_60", 1, {"leaves dataset"});
   EXPECT_FALSE(exists(dir + "all.yaml"));
-  // sweep --skip-chaotic diagnoses each synthetic dataset without those runs, and says how many.
-  expectRun("sweep --quiet --level fast --cases none --seeds 1 --skip-chaotic", 0,
-            {"left out (--skip-chaotic)", ") without "});
-  expectRun("compare " + dir + "fast --no-plots --skip-chaotic --out " + dir + "c", 1,
-            {"unknown option --skip-chaotic for 'compare'"});
+  // sweep diagnoses each synthetic dataset without those runs, and says how many; --keep-chaotic keeps them.
+  expectRun("sweep --quiet --level fast --cases none --seeds 1", 0, {"reproducibly left out", ") without "});
+  const std::string all = expectRun("sweep --quiet --level fast --cases none --seeds 1 --keep-chaotic", 0, {"(--keep-chaotic)"});
+  EXPECT_FALSE(contains(all, ") without ")) << all;
+  expectRun("compare " + dir + "fast --no-plots --keep-chaotic --out " + dir + "c", 1,
+            {"unknown option --keep-chaotic for 'compare'"});
 }
 
 TEST(Cli, TheOptionsItTakesAreAccepted) {
