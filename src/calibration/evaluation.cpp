@@ -262,4 +262,88 @@ ReplayableRuns replayableRuns(const Dataset& ds, const ModelSpec& model, const E
   return out;
 }
 
+std::string describeSplit(const ReplayableRuns& split, bool kept_on_request) {
+  if (split.chaotic.empty()) return "";
+  std::ostringstream moved_by;
+  moved_by << "a start " << kStartNudge << " sigma of the tracker noise away moves them by more than "
+           << kChaoticSensitivity << " noise";
+  const std::string moved = moved_by.str();
+  std::ostringstream o;
+  if (kept_on_request || split.all_chaotic)
+    o << "note: the start model does not reproduce these runs (" << moved << "): " << split.chaotic
+      << "; their residuals are not evidence of a missing effect; kept ("
+      << (split.all_chaotic ? "every run is: nothing would be left to fit" : "--keep-chaotic") << ")";
+  else
+    o << "leaving out " << split.left_out.size() << (split.left_out.size() == 1 ? " run" : " runs")
+      << " the start model does not reproduce (" << moved << "; --keep-chaotic keeps them): " << split.chaotic;
+  return o.str();
+}
+
+namespace {
+/// The effects of `before` that `after` no longer has, comma-separated ("" if none).
+std::string effectsLost(const ModelSpec& before, const ModelSpec& after) {
+  std::string lost;
+  for (const auto& e : before.effects)
+    if (std::none_of(after.effects.begin(), after.effects.end(), [&](const EffectConfig& a) { return a.name == e.name; }))
+      lost += (lost.empty() ? "" : ", ") + e.name;
+  return lost;
+}
+}  // namespace
+
+ReplayableRounds solveOnReplayableRuns(const Dataset& ds, const ModelSpec& start, const EvalOptions& opt,
+                                       bool keep_chaotic, WorkerPool& pool,
+                                       const std::function<ModelSpec(const Dataset& runs, const std::string& message)>& solve) {
+  const ReplayableRuns split = replayableRuns(ds, start, opt, pool);
+  ReplayableRounds out;  // the round whose result stands
+  out.dataset = keep_chaotic ? ds : split.dataset;
+  if (!keep_chaotic) out.left_out = split.left_out;
+  ModelSpec solved = solve(out.dataset, describeSplit(split, keep_chaotic));
+  while (!out.left_out.empty() && out.rounds < kMaxReplayableRounds) {
+    const std::set<std::string> was_out(out.left_out.begin(), out.left_out.end());
+    Dataset left = ds;
+    left.runs.clear();
+    for (const auto& r : ds.runs)
+      if (was_out.count(r.name)) left.runs.push_back(r);
+    std::ostringstream back;
+    back << std::fixed << std::setprecision(1);
+    std::set<std::string> readmit;
+    for (const auto& s : replaySensitivity(left, solved, opt, pool))
+      if (s.nrms <= kChaoticSensitivity) {
+        readmit.insert(left.runs[s.run].name);
+        back << (readmit.size() > 1 ? ", " : "") << left.runs[s.run].name << " " << s.nrms;
+      }
+    if (readmit.empty()) break;
+    ReplayableRounds next = out;
+    next.dataset.runs.clear();
+    next.left_out.clear();
+    for (const auto& r : ds.runs) {
+      if (!was_out.count(r.name) || readmit.count(r.name)) next.dataset.runs.push_back(r);
+      if (readmit.count(r.name)) next.readmitted.push_back(r.name);
+      if (was_out.count(r.name) && !readmit.count(r.name)) next.left_out.push_back(r.name);
+    }
+    next.round = out.rounds = next.rounds = out.rounds + 1;
+    std::string effects;
+    for (const auto& e : solved.effects) effects += (effects.empty() ? "" : ", ") + e.name;
+    const std::string message =
+        "the model round " + std::to_string(out.round) + " ended with (" + (effects.empty() ? "no effect" : effects) +
+        ") reproduces " + std::to_string(readmit.size()) + " of the " + std::to_string(was_out.size()) +
+        " runs left out (" + back.str() + "): re-admitted; round " + std::to_string(next.round) + " on " +
+        std::to_string(next.dataset.runs.size()) + " runs, from the start model";
+    const ModelSpec next_solved = solve(next.dataset, message);
+    // A re-admitted run can be reproducible at round 1's values only: the fits of round 2, which start
+    // from the start model and move through chaotic values, then lose the effect round 1 found
+    // (Medium torque saturation lost 2 of 5 so). Adding runs must add evidence, not take it away.
+    if (const std::string lost = effectsLost(solved, next_solved); !lost.empty()) {
+      out.note = "round " + std::to_string(next.round) + " ended without " + lost + ", which round " +
+                 std::to_string(out.round) + " found: the runs re-admitted are not reproducible away from its values, "
+                 "so round " + std::to_string(out.round) + "'s result stands (on " +
+                 std::to_string(out.dataset.runs.size()) + " runs)";
+      break;
+    }
+    out = next;
+    solved = next_solved;
+  }
+  return out;
+}
+
 }  // namespace sbot::calib

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
@@ -111,5 +112,32 @@ struct ReplayableRuns {
 /// The runs `model` replays reproducibly from its own start (what diagnose, fit and sweep fit by
 /// default; their --keep-chaotic keeps every run).
 ReplayableRuns replayableRuns(const Dataset& ds, const ModelSpec& model, const EvalOptions& opt, WorkerPool& pool);
+
+/// The line that says which runs `split` leaves out (or keeps: `kept_on_request` is --keep-chaotic);
+/// empty when every run is reproducible.
+std::string describeSplit(const ReplayableRuns& split, bool kept_on_request);
+
+/// The runs a fit or a diagnosis ends on (solveOnReplayableRuns).
+struct ReplayableRounds {
+  Dataset dataset;                      ///< the runs the last round solved on
+  std::vector<std::string> left_out;    ///< the runs left out of the last round, in dataset order
+  std::vector<std::string> readmitted;  ///< the runs re-admitted after round 1, in dataset order
+  int round = 1;                        ///< the round whose result stands (1-based)
+  int rounds = 1;                       ///< rounds solved
+  std::string note;                     ///< why a later round was not kept ("" if the last one stands)
+};
+constexpr int kMaxReplayableRounds = 3;
+/// Solve (fit, diagnose) on the runs a model replays reproducibly. Round 1: the runs `start` replays
+/// (replayableRuns; every run if `keep_chaotic` or if none is). A solved model can replay a run the
+/// start model could not (halved lateral track friction makes a Medium's fast spins skid evenly, and
+/// those spins show the effect best), so while the model a round ends with replays some of the runs
+/// left out, they are re-admitted and `solve` runs again, from `start`, on the larger set (at most
+/// kMaxReplayableRounds rounds). A round that loses an effect the round before found does not stand:
+/// its runs were reproducible at the earlier values only (`note` says so). `solve(runs, message)`
+/// returns the model it ends with; `message` says which runs were left out or re-admitted ("" when
+/// nothing was). The caller keeps each round's result and uses round `round`'s.
+ReplayableRounds solveOnReplayableRuns(const Dataset& ds, const ModelSpec& start, const EvalOptions& opt,
+                                       bool keep_chaotic, WorkerPool& pool,
+                                       const std::function<ModelSpec(const Dataset& runs, const std::string& message)>& solve);
 
 }  // namespace sbot::calib

@@ -10,7 +10,8 @@
 //   sbot_calibrate effects  (list the effects library)
 //   common: --jobs N (worker processes, default: all cores), --quiet; compare/diagnose/fit also
 //           --solver quickstep|exact (replaces the dataset's world stepper) and --skip-runs a,b;
-//           diagnose/fit/sweep leave out the runs the start model cannot replay (--keep-chaotic keeps them)
+//           diagnose/fit/sweep leave out the runs the start model cannot replay until the model they end
+//           with can (--keep-chaotic keeps them)
 // Output places (--out, --write-effects) are created and checked before the work: a fit or a
 // diagnosis runs for minutes, and its result must not be lost to an unwritable path at the end. They
 // are checked after the input (dataset, effects, option values), so a refused run creates no folder.
@@ -275,7 +276,7 @@ void usage() {
                "common options: --jobs N (worker processes; default all cores), --quiet;\n"
                "  compare/diagnose/fit: --solver quickstep|exact replaces the dataset's world stepper,\n"
                "    --skip-runs a,b leaves those runs out; diagnose/fit/sweep leave out the runs the start model does\n"
-               "    not reproduce (named; --keep-chaotic keeps them)\n");
+               "    not reproduce, and solve again with those the model they end with does (named; --keep-chaotic keeps them)\n");
 }
 
 /// --solver (the world's stepper), checked.
@@ -308,24 +309,6 @@ ModelSpec baseModel(const Dataset& ds, const Args& a) {
   loadLevel(m.level);  // an unknown level is named now, not by the first replay
   if (a.has("effects")) m.effects = effectsOption(ds, a);
   return m;
-}
-
-/// The runs the start model can replay from its own start (evaluation.h, ReplaySensitivity): fitting
-/// the others fits where a chaotic trajectory happened to go. Named always; kept with --keep-chaotic.
-Dataset runsToFit(const Dataset& ds, const ModelSpec& start, const Args& a) {
-  const ReplayableRuns r = replayableRuns(ds, start, EvalOptions(), WorkerPool::global());
-  if (r.chaotic.empty()) return ds;
-  if (a.has("keep-chaotic") || r.all_chaotic) {
-    std::printf("note: the start model does not reproduce these runs (a start %g sigma of the tracker noise away moves them "
-                "by more than %g noise): %s; their residuals are not evidence of a missing effect; kept (%s)\n",
-                kStartNudge, kChaoticSensitivity, r.chaotic.c_str(),
-                r.all_chaotic ? "every run is: nothing would be left to fit" : "--keep-chaotic");
-    return ds;
-  }
-  std::printf("leaving out %zu run%s the start model does not reproduce (a start %g sigma of the tracker noise away moves "
-              "them by more than %g noise; --keep-chaotic keeps them): %s\n",
-              r.left_out.size(), r.left_out.size() == 1 ? "" : "s", kStartNudge, kChaoticSensitivity, r.chaotic.c_str());
-  return r.dataset;
 }
 
 int cmdEffects() {
@@ -419,19 +402,30 @@ int cmdDiagnose(const Args& a) {
   o.progress = !a.has("quiet");
   if (a.has("verbose")) o.log = [](const std::string& s) { std::fprintf(stderr, "%s\n", s.c_str()); };
   if (a.has("write-effects")) checkOutputPlace("write-effects", a.get("write-effects"), false);
-  const Dataset ds = runsToFit(measured, o.base, a);
-  // The runs left must still measure what the named candidates act on.
-  if (a.has("candidates") && ds.runs.size() < measured.runs.size()) o.candidates = namedCandidates(ds, a);
   WorkerPool& pool = WorkerPool::global();
-  const int folds = foldCount(ds, o.folds);
-  std::printf("diagnose %s: %zu runs, %zu samples, level %s, %d fold%s, %d worker process%s\n", ds.name.c_str(),
-              ds.runs.size(), ds.sampleCount(), o.base.level.c_str(), folds, folds == 1 ? "" : "s", pool.size(),
-              pool.size() == 1 ? "" : "es");
-  if (folds < o.folds)
-    std::printf("note: --folds %d, but a fold holds out whole runs and the dataset has %zu run%s: %d fold%s\n", o.folds,
-                ds.runs.size(), ds.runs.size() == 1 ? "" : "s", folds, folds == 1 ? " (scores in-sample)" : "s");
-  if (o.candidates.empty()) printSkippedCandidates(ds);
-  const DiagnoseResult r = diagnose(ds, o, pool);
+  // On the runs the start model replays reproducibly, and again with those the diagnosed model
+  // replays too (evaluation.h, solveOnReplayableRuns).
+  std::vector<DiagnoseResult> results;  // per round
+  const auto t0 = std::chrono::steady_clock::now();
+  const ReplayableRounds rounds = solveOnReplayableRuns(measured, o.base, o.fit.eval, a.has("keep-chaotic"), pool,
+                                                        [&](const Dataset& ds, const std::string& message) {
+    if (!message.empty()) std::printf("%s\n", message.c_str());
+    // The runs left must still measure what the named candidates act on.
+    if (a.has("candidates") && ds.runs.size() < measured.runs.size()) o.candidates = namedCandidates(ds, a);
+    const int folds = foldCount(ds, o.folds);
+    std::printf("diagnose %s: %zu runs, %zu samples, level %s, %d fold%s, %d worker process%s\n", ds.name.c_str(),
+                ds.runs.size(), ds.sampleCount(), o.base.level.c_str(), folds, folds == 1 ? "" : "s", pool.size(),
+                pool.size() == 1 ? "" : "es");
+    if (folds < o.folds)
+      std::printf("note: --folds %d, but a fold holds out whole runs and the dataset has %zu run%s: %d fold%s\n", o.folds,
+                  ds.runs.size(), ds.runs.size() == 1 ? "" : "s", folds, folds == 1 ? " (scores in-sample)" : "s");
+    if (o.candidates.empty() && results.empty()) printSkippedCandidates(ds);  // the runs added measure the same channels
+    results.push_back(diagnose(ds, o, pool));
+    return results.back().final_model;
+  });
+  if (!rounds.note.empty()) std::printf("%s\n", rounds.note.c_str());
+  const Dataset& ds = rounds.dataset;
+  const DiagnoseResult& r = results.at(rounds.round - 1);
   for (std::size_t i = 0; i < r.rounds.size(); ++i) {
     const auto& rd = r.rounds[i];
     std::printf("\nstep %zu: candidates ranked by held-out evidence (current held-out RSS %.1f)\n", i + 1,
@@ -450,7 +444,11 @@ int cmdDiagnose(const Args& a) {
     }
   }
   std::printf("\n%s", r.verdict.c_str());
-  std::printf("diagnose took %.1f s wall, %d run simulations, %d worker processes\n", r.seconds, r.simulations, pool.size());
+  std::printf("diagnose took %.1f s wall, %d run simulations, %d worker processes", r.seconds, r.simulations, pool.size());
+  if (results.size() > 1)
+    std::printf(" (round %d; %.1f s for all %zu rounds)", rounds.round,
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), results.size());
+  std::printf("\n");
   if (a.has("write-effects")) {
     // Also with nothing accepted: the file then holds the model diagnose ends with (the nominal one,
     // or --effects' base), so that the next step (compare --effects FILE) works either way.
@@ -504,10 +502,6 @@ int cmdFit(const Args& a) {
   FitOptions fo;
   fo.max_iterations = static_cast<int>(a.whole("max-iterations", fo.max_iterations, 1, 1000, "Levenberg-Marquardt iterations"));
   checkOutputPlace("out", a.get("out"), false);
-  const Dataset ds = runsToFit(measured, start, a);
-  for (const auto& n : names)
-    if (const std::string why = unmeasuredChannels(ds, n); !why.empty())
-      throw std::invalid_argument("--effect: " + why + " in the runs left: there is nothing to fit it to");
   WorkerPool& pool = WorkerPool::global();
   std::size_t evals = 0;
   const bool quiet = a.has("quiet");
@@ -515,12 +509,27 @@ int cmdFit(const Args& a) {
     ++evals;
     if (!quiet) std::fprintf(stderr, "\rfitting: %zu re-simulation batches", evals);
   };
-  const auto t0 = std::chrono::steady_clock::now();
-  const FitResult r = fitModel(ds, m, freeParamsOf(m, idx), allRuns(ds), fo, pool);
-  if (!quiet) std::fprintf(stderr, "\n");
-  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("fit on %zu runs (%zu samples), %d iterations, %d batches, %.1f s%s\n", ds.runs.size(), r.n, r.iterations,
-              r.evaluations, secs, r.converged ? "" : " (iteration limit)");
+  // On the runs the start model replays reproducibly, and again, from the start, with those the
+  // fitted model replays too (evaluation.h, solveOnReplayableRuns). A fit keeps its effects in every
+  // round, so its last round stands.
+  Dataset ds;
+  FitResult r;
+  solveOnReplayableRuns(measured, start, EvalOptions(), a.has("keep-chaotic"), pool,
+                        [&](const Dataset& runs, const std::string& message) {
+    if (!message.empty()) std::printf("%s\n", message.c_str());
+    ds = runs;
+    for (const auto& n : names)
+      if (const std::string why = unmeasuredChannels(ds, n); !why.empty())
+        throw std::invalid_argument("--effect: " + why + " in the runs left: there is nothing to fit it to");
+    evals = 0;
+    const auto t0 = std::chrono::steady_clock::now();
+    r = fitModel(ds, m, freeParamsOf(m, idx), allRuns(ds), fo, pool);
+    if (!quiet) std::fprintf(stderr, "\n");
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("fit on %zu runs (%zu samples), %d iterations, %d batches, %.1f s%s\n", ds.runs.size(), r.n, r.iterations,
+                r.evaluations, secs, r.converged ? "" : " (iteration limit)");
+    return r.model;
+  });
   // A fit stopped by its iteration limit is not at a minimum: the curvature there gives an interval
   // about a point the data do not single out (accel_limit 2.103 +- 0.002 for a true 2.0). Its values
   // are written, as a start for another fit, but with no interval.

@@ -76,6 +76,9 @@ void save(Writer& w, const SeedOutcome& o) {
   save(w, o.seconds);
   save(w, o.verdict);
   save(w, o.left_out);
+  save(w, o.readmitted);
+  save(w, o.round);
+  save(w, o.rounds);
 }
 void load(Reader& r, SeedOutcome& o) {
   load(r, o.seed);
@@ -93,6 +96,9 @@ void load(Reader& r, SeedOutcome& o) {
   load(r, o.seconds);
   load(r, o.verdict);
   load(r, o.left_out);
+  load(r, o.readmitted);
+  load(r, o.round);
+  load(r, o.rounds);
 }
 
 std::vector<SweepCase> standardCases(const std::string&) {
@@ -175,14 +181,21 @@ std::vector<CaseSummary> runSweep(const SweepOptions& opt, WorkerPool& pool) {
     d.progress = false;
     d.seed = o.seed;
     d.base.level = g.level;
-    if (!opt.keep_chaotic) {
-      ReplayableRuns kept = replayableRuns(ds, d.base, d.fit.eval, pool);
-      o.left_out = kept.left_out;
-      ds = std::move(kept.dataset);
-    }
+    // As diagnose does: on the runs the start model replays, then with those the diagnosed one does.
     const auto ts = std::chrono::steady_clock::now();
-    const DiagnoseResult r = diagnose(ds, d, pool);
+    std::vector<DiagnoseResult> results;  // per round
+    const ReplayableRounds rounds = solveOnReplayableRuns(ds, d.base, d.fit.eval, opt.keep_chaotic, pool,
+                                                          [&](const Dataset& runs, const std::string&) {
+                                                            results.push_back(diagnose(runs, d, pool));
+                                                            return results.back().final_model;
+                                                          });
+    const DiagnoseResult& r = results.at(rounds.round - 1);
     o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ts).count();
+    o.left_out = rounds.left_out;
+    o.readmitted = rounds.readmitted;
+    o.round = rounds.round;
+    o.rounds = rounds.rounds;
+    ds = rounds.dataset;
     o.accepted = r.accepted;
     o.rms_before = r.heldout_rms_before;
     o.rms_after = r.heldout_rms_after;
@@ -266,7 +279,7 @@ std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions&
      << opt.gen.duration << " s, solver " << opt.gen.solver << ", " << opt.diag.folds << "-fold split by run, acceptance dBIC > "
      << opt.diag.bic_threshold
      << (opt.keep_chaotic ? "; every run kept, also those the starting model does not replay reproducibly (--keep-chaotic)"
-                          : "; runs the starting model does not replay reproducibly left out")
+                          : "; runs the starting model does not replay reproducibly left out until a diagnosed model does")
      << "; " << std::fixed << std::setprecision(0) << seconds << " s wall.\n\n";
   md << "| hidden | truth | right first | params +-10 % | held-out RMS -50 % | ends <= 1.2x floor | failing channels -50 % | "
         "failing channels <= 1.2x floor | nothing accepted | structure flagged | both found | s/diagnose |\n"
@@ -305,6 +318,8 @@ std::string sweepMarkdown(const std::vector<CaseSummary>& s, const SweepOptions&
       }
       md << std::setprecision(2) << o.rms_before << "->" << o.rms_after << " (" << o.floor << ")";
       if (!o.left_out.empty()) md << " without " << o.left_out.size() << " run" << (o.left_out.size() == 1 ? "" : "s");
+      if (!o.readmitted.empty()) md << " (" << o.readmitted.size() << " re-admitted)";
+      if (o.round < o.rounds) md << " (round " << o.round << " of " << o.rounds << ": round " << o.round + 1 << " lost an effect)";
       if (!o.failing_channels.empty()) {
         std::string ch;
         for (const auto& x : o.failing_channels) ch += (ch.empty() ? "" : ",") + x;

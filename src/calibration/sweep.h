@@ -36,7 +36,9 @@ struct SeedOutcome {
   bool structure_flagged = false;
   double seconds = 0;
   std::string verdict;
-  std::vector<std::string> left_out;  ///< runs the starting model could not replay, left out (not with keep_chaotic)
+  std::vector<std::string> left_out;  ///< runs no diagnosed model could replay, left out (not with keep_chaotic)
+  std::vector<std::string> readmitted;  ///< runs the starting model could not replay but a diagnosed one could
+  int round = 1, rounds = 1;            ///< the round that stands, of the rounds diagnosed (solveOnReplayableRuns)
 };
 
 struct CaseSummary {
@@ -65,8 +67,8 @@ struct SweepOptions {
   GeneratorOptions gen;          ///< level, duration, families (hidden/seed/tilt set per case)
   DiagnoseOptions diag;
   /// Diagnose every run, also those the starting model does not replay reproducibly (--keep-chaotic).
-  /// By default they are left out, as diagnose does (evaluation.h replayableRuns), and the noise floor
-  /// is the true model's on the runs kept.
+  /// By default they are left out and re-admitted once a diagnosed model replays them, as diagnose
+  /// does (evaluation.h solveOnReplayableRuns); the noise floor is the true model's on the runs kept.
   bool keep_chaotic = false;
   bool progress = false;
 };

@@ -27,6 +27,15 @@ Dataset smallDataset(const std::vector<EffectConfig>& hidden, std::uint64_t seed
   return generateDataset(g, WorkerPool::global());
 }
 
+/// Fast (1/50 g) driving straight at 20/40/60 units and in two arcs, in which it tips over.
+Dataset fastStraightsAndArcs() {
+  GeneratorOptions g;
+  g.level = "fast";
+  g.seed = 3;
+  g.experiments = {"straight", "arc"};
+  return generateDataset(g, WorkerPool::global());
+}
+
 TEST(WorkerPool, MapsInWorkersLikeInline) {
   WorkerPool two(2), one(1);
   std::function<std::vector<double>(std::size_t)> fn = [](std::size_t i) {
@@ -92,11 +101,7 @@ TEST(Generator, TrueModelSitsAtTheNoiseFloorAndTheNominalDoesNot) {
 // missing effect: the Fast robot (1/50 g) tips over in a 30/55-unit arc, which makes its replay
 // depend on where within the tracker noise its start lies; driving straight at 20 units it does not.
 TEST(ReplaySensitivity, NamesTheRunsEvenTheTrueModelCannotReproduce) {
-  GeneratorOptions g;
-  g.level = "fast";
-  g.seed = 3;
-  g.experiments = {"straight", "arc"};
-  const Dataset ds = generateDataset(g, WorkerPool::global());
+  const Dataset ds = fastStraightsAndArcs();
   const ModelSpec truth{ds.robot, {}};
   const auto s = replaySensitivity(ds, truth, EvalOptions(), WorkerPool::global());
   ASSERT_EQ(s.size(), ds.runs.size()) << "every run is a drive run";
@@ -115,6 +120,65 @@ TEST(ReplaySensitivity, NamesTheRunsEvenTheTrueModelCannotReproduce) {
     if (ds.runs[rr.run].name == "straight_20") EXPECT_LT(rms, 1.3);
   }
   EXPECT_GT(ev.rmsNormalised(), 2.0) << "the chaotic arcs lift the true model's floor";
+}
+
+// diagnose, fit and sweep solve on the runs the start model replays (the Fast arcs are left out),
+// and re-admit those the model a round ends with replays: Simple (full size, 1 g) does not tip over
+// in them. A model that is as chaotic as the start leaves one round; --keep-chaotic solves on all.
+TEST(ReplayableRuns, AreLeftOutAndReadmittedOnceASolvedModelReplaysThem) {
+  const Dataset ds = fastStraightsAndArcs();
+  const ModelSpec start{"fast", {}};
+  std::vector<std::size_t> sizes;
+  std::vector<std::string> messages;
+  // A solver that ends round i with models[i] (the last one for later rounds).
+  auto solvingTo = [&](const std::vector<ModelSpec>& models) {
+    sizes.clear();
+    messages.clear();
+    return [&, models](const Dataset& runs, const std::string& message) {
+      sizes.push_back(runs.runs.size());
+      messages.push_back(message);
+      return models[std::min(sizes.size(), models.size()) - 1];
+    };
+  };
+  const std::vector<std::string> arcs{"arc_left", "arc_right"};
+
+  const ReplayableRounds stays = solveOnReplayableRuns(ds, start, EvalOptions(), false, WorkerPool::global(), solvingTo({start}));
+  EXPECT_EQ(stays.rounds, 1);
+  EXPECT_EQ(sizes, (std::vector<std::size_t>{3}));
+  EXPECT_EQ(stays.left_out, arcs);
+  EXPECT_TRUE(stays.readmitted.empty());
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_NE(messages[0].find("leaving out 2 runs the start model does not reproduce"), std::string::npos) << messages[0];
+
+  const ReplayableRounds back =
+      solveOnReplayableRuns(ds, start, EvalOptions(), false, WorkerPool::global(), solvingTo({ModelSpec{"simple", {}}}));
+  EXPECT_EQ(back.rounds, 2);
+  EXPECT_EQ(back.round, 2);
+  EXPECT_TRUE(back.note.empty()) << back.note;
+  EXPECT_EQ(sizes, (std::vector<std::size_t>{3, 5}));
+  EXPECT_TRUE(back.left_out.empty());
+  EXPECT_EQ(back.readmitted, arcs);
+  EXPECT_EQ(back.dataset.runs.size(), ds.runs.size());
+  ASSERT_EQ(messages.size(), 2u);
+  EXPECT_NE(messages[1].find("reproduces 2 of the 2 runs left out"), std::string::npos) << messages[1];
+  EXPECT_NE(messages[1].find("round 2 on 5 runs"), std::string::npos) << messages[1];
+
+  // A round that loses an effect the round before found does not stand.
+  const EffectConfig slower{"speed_scale", {{"scale", 0.9}}, {}, ""};
+  const ReplayableRounds lost = solveOnReplayableRuns(ds, start, EvalOptions(), false, WorkerPool::global(),
+                                                      solvingTo({ModelSpec{"simple", {slower}}, ModelSpec{"simple", {}}}));
+  EXPECT_EQ(lost.rounds, 2);
+  EXPECT_EQ(lost.round, 1);
+  EXPECT_EQ(lost.left_out, arcs);
+  EXPECT_EQ(lost.dataset.runs.size(), 3u);
+  EXPECT_NE(lost.note.find("round 2 ended without speed_scale, which round 1 found"), std::string::npos) << lost.note;
+
+  const ReplayableRounds kept = solveOnReplayableRuns(ds, start, EvalOptions(), true, WorkerPool::global(), solvingTo({start}));
+  EXPECT_EQ(kept.rounds, 1);
+  EXPECT_EQ(sizes, (std::vector<std::size_t>{5}));
+  EXPECT_TRUE(kept.left_out.empty());
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_NE(messages[0].find("kept (--keep-chaotic)"), std::string::npos) << messages[0];
 }
 
 // The seed's published sensor response points (Appendix A; datasets/make_seed_datasets.py places the
