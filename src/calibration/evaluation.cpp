@@ -245,20 +245,17 @@ std::string describeChaoticRuns(const Dataset& ds, const std::vector<ReplaySensi
 
 ReplayableRuns replayableRuns(const Dataset& ds, const ModelSpec& model, const EvalOptions& opt, WorkerPool& pool) {
   const std::vector<ReplaySensitivity> sens = replaySensitivity(ds, model, opt, pool);
-  std::set<int> chaotic;
+  std::set<std::string> chaotic;
   for (const auto& r : sens)
-    if (r.nrms > kChaoticSensitivity) chaotic.insert(r.run);
+    if (r.nrms > kChaoticSensitivity) chaotic.insert(ds.runs[r.run].name);
   ReplayableRuns out;
   out.chaotic = describeChaoticRuns(ds, sens);
   out.all_chaotic = !chaotic.empty() && chaotic.size() == ds.runs.size();
   out.dataset = ds;
   if (chaotic.empty() || out.all_chaotic) return out;
-  out.dataset.runs.clear();
-  for (int i = 0; i < static_cast<int>(ds.runs.size()); ++i)
-    if (chaotic.count(i))
-      out.left_out.push_back(ds.runs[i].name);
-    else
-      out.dataset.runs.push_back(ds.runs[i]);
+  out.dataset = withoutRuns(ds, chaotic);
+  for (const auto& r : ds.runs)
+    if (chaotic.count(r.name)) out.left_out.push_back(r.name);
   return out;
 }
 
@@ -280,6 +277,12 @@ std::string describeSplit(const ReplayableRuns& split, bool kept_on_request) {
 }
 
 namespace {
+bool sameModel(const ModelSpec& a, const ModelSpec& b) {
+  return a.level == b.level &&
+         std::equal(a.effects.begin(), a.effects.end(), b.effects.begin(), b.effects.end(),
+                    [](const EffectConfig& x, const EffectConfig& y) { return x.name == y.name && x.params == y.params; });
+}
+
 /// The effects of `before` that `after` no longer has, comma-separated ("" if none).
 std::string effectsLost(const ModelSpec& before, const ModelSpec& after) {
   std::string lost;
@@ -298,7 +301,9 @@ ReplayableRounds solveOnReplayableRuns(const Dataset& ds, const ModelSpec& start
   out.dataset = keep_chaotic ? ds : split.dataset;
   if (!keep_chaotic) out.left_out = split.left_out;
   ModelSpec solved = solve(out.dataset, describeSplit(split, keep_chaotic));
-  while (!out.left_out.empty() && out.rounds < kMaxReplayableRounds) {
+  // A round that ends with the start model would replay the runs left out exactly as before (replays
+  // are deterministic): nothing to check.
+  while (!out.left_out.empty() && out.rounds < kMaxReplayableRounds && !sameModel(solved, start)) {
     const std::set<std::string> was_out(out.left_out.begin(), out.left_out.end());
     Dataset left = ds;
     left.runs.clear();
@@ -313,13 +318,15 @@ ReplayableRounds solveOnReplayableRuns(const Dataset& ds, const ModelSpec& start
         back << (readmit.size() > 1 ? ", " : "") << left.runs[s.run].name << " " << s.nrms;
       }
     if (readmit.empty()) break;
+    std::set<std::string> still_out;
+    for (const auto& n : was_out)
+      if (!readmit.count(n)) still_out.insert(n);
     ReplayableRounds next = out;
-    next.dataset.runs.clear();
+    next.dataset = still_out.empty() ? ds : withoutRuns(ds, still_out);
     next.left_out.clear();
     for (const auto& r : ds.runs) {
-      if (!was_out.count(r.name) || readmit.count(r.name)) next.dataset.runs.push_back(r);
       if (readmit.count(r.name)) next.readmitted.push_back(r.name);
-      if (was_out.count(r.name) && !readmit.count(r.name)) next.left_out.push_back(r.name);
+      if (still_out.count(r.name)) next.left_out.push_back(r.name);
     }
     next.round = out.rounds = next.rounds = out.rounds + 1;
     std::string effects;
