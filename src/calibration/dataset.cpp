@@ -269,6 +269,41 @@ bool isKnownColumn(const std::string& c) {
   return std::regex_match(c, indexed);
 }
 
+namespace {
+/// Why a drive run's times look like milliseconds (or its positions like kilometres) although each
+/// row gap and the run's length passed their limits ("" if nothing does): rows a second or more
+/// apart (a tracker at under 1 Hz) and a robot that moved under 1/100 of what its commands ask for.
+/// Either alone is possible (a slow logger; a robot pushing a wall); together they are a 1000x
+/// stretched time axis, which the replay would simulate for hours.
+std::string timeUnitProblem(const Run& run, std::vector<double> row_gaps) {
+  // The seed's API speed unit, 2.8 mm/s (Fast's is half: the 100x margin covers every level).
+  constexpr double kNominalSpeedUnit = 0.0028;  // [m/s]
+  const auto x = run.channels.find("x"), y = run.channels.find("y");
+  if (row_gaps.empty() || x == run.channels.end() || y == run.channels.end() || x->second.v.size() < 2 ||
+      x->second.v.size() != y->second.v.size())
+    return "";
+  std::nth_element(row_gaps.begin(), row_gaps.begin() + row_gaps.size() / 2, row_gaps.end());
+  const double median_gap = row_gaps[row_gaps.size() / 2];
+  if (median_gap < 1.0) return "";
+  double asked = 0;  // [m] the forward distance the commands ask for, where the tracks are driven
+  for (std::size_t i = 0; i < run.cmd_t.size(); ++i) {
+    const double until = i + 1 < run.cmd_t.size() ? run.cmd_t[i + 1] : run.t_end;
+    if (run.passiveAt(run.cmd_t[i])) continue;
+    asked += std::abs(0.5 * (run.cmd_left[i] + run.cmd_right[i])) * kNominalSpeedUnit *
+             std::max(0.0, until - std::max(0.0, run.cmd_t[i]));
+  }
+  const Series &sx = x->second, &sy = y->second;
+  const double moved = std::hypot(sx.v.back() - sx.v.front(), sy.v.back() - sy.v.front());  // [m]
+  double path = 0;  // [m] along the samples (noise only lengthens it)
+  for (std::size_t i = 1; i < sx.v.size(); ++i) path += std::hypot(sx.v[i] - sx.v[i - 1], sy.v[i] - sy.v[i - 1]);
+  if (asked < 0.05 || path * 100 >= asked) return "";
+  return "rows " + fmtNumber(median_gap) + " s apart (median) and the robot moved " + fmtNumber(moved) + " m (" +
+         fmtNumber(path) + " m along its samples) in " + fmtNumber(run.t_end) +
+         " s where its commands ask for about " + fmtNumber(asked) +
+         " m: are the times in milliseconds? (t must be in seconds, x and y in metres)";
+}
+}  // namespace
+
 void parseRunCsv(const std::string& text, const std::string& file, Run& run) {
   // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first column's name.
   const bool bom = text.rfind("\xEF\xBB\xBF", 0) == 0;
@@ -344,6 +379,7 @@ void parseRunCsv(const std::string& text, const std::string& file, Run& run) {
   int last_t_line = 0;
   double max_gap = 0;  // [s] the longest time between two consecutive rows, and where it ends
   int max_gap_line = 0;
+  std::vector<double> row_gaps;  // [s] between consecutive rows (timeUnitProblem)
   int row = 0;
   while (std::getline(in, raw)) {
     ++line_no;
@@ -373,6 +409,7 @@ void parseRunCsv(const std::string& text, const std::string& file, Run& run) {
         throw DatasetError(file, line_no, col.at("t") + 1, "t",
                            "time is not increasing (" + std::to_string(t) + " after " + std::to_string(last_t) +
                                " on line " + std::to_string(last_t_line) + ")");
+      if (row > 0) row_gaps.push_back(t - last_t);
       if (row > 0 && t - last_t > max_gap) {
         max_gap = t - last_t;
         max_gap_line = line_no;
@@ -444,6 +481,9 @@ void parseRunCsv(const std::string& text, const std::string& file, Run& run) {
     throw DatasetError(file, max_gap_line, col.at("t") + 1, "t",
                        "a gap of " + fmtNumber(max_gap) + " s since the previous row; gaps over " + fmtNumber(kMaxRowGap) +
                            " s are refused (the replay would simulate them blind): are the times in seconds?");
+  if (drive)
+    if (const std::string problem = timeUnitProblem(run, row_gaps); !problem.empty())
+      throw DatasetError(file, last_t_line, col.at("t") + 1, "t", problem);
   if (run.sampleCount() == 0)
     throw DatasetError(file, header_line, 0, "", "no measured value in any row: nothing to compare the model with");
   for (const auto& c : measured)

@@ -242,6 +242,31 @@ TEST(Dataset, ValuesNoReplayCanUseAreRefusedByPlace) {
   EXPECT_NO_THROW(loadDataset(makeDataset("bom", "\xEF\xBB\xBFt,cmd_left,cmd_right,x\n0,1,1,0\n")));
 }
 
+// Milliseconds at a tracker's rate pass the row-gap and run-length limits (33 ms "gaps", a 2000 s
+// "run"); the replay would then drive the robot for half an hour. Rows a second apart together with
+// a robot that moved a thousandth of what its commands ask for give them away; either alone does not.
+TEST(Dataset, MillisecondTimesAreRefusedAndSlowLoggersAreNot) {
+  // 2 s at 30 Hz, setSpeed(20, 20) = 5.6 cm/s, the tracker noise-free: 11.2 cm.
+  const auto run = [](double time_scale, double rate_hz, double speed) {
+    std::string csv = "t,cmd_left,cmd_right,x,y\n";
+    const int rows = static_cast<int>(2.0 * rate_hz);
+    for (int i = 0; i <= rows; ++i) {
+      const double t = i / rate_hz;
+      csv += std::to_string(t * time_scale) + (i == 0 ? ",20,20," : ",,,") + std::to_string(speed * t) + ",0\n";
+    }
+    return csv;
+  };
+  const DatasetError e = errorOf(makeDataset("ms", run(1000, 30, 0.056)));
+  EXPECT_EQ(e.line(), 62) << e.what();
+  EXPECT_EQ(e.columnName(), "t") << e.what();
+  EXPECT_NE(std::string(e.what()).find("are the times in milliseconds?"), std::string::npos) << e.what();
+  EXPECT_NE(std::string(e.what()).find("moved 0.112 m"), std::string::npos) << e.what();
+  // The same run in seconds; a 1 Hz logger of a moving robot; a 30 Hz log of a robot pushing a wall.
+  EXPECT_NO_THROW(loadDataset(makeDataset("s", run(1, 30, 0.056))));
+  EXPECT_NO_THROW(loadDataset(makeDataset("slow_logger", run(1, 1, 0.056))));
+  EXPECT_NO_THROW(loadDataset(makeDataset("wall", run(1, 30, 0.0))));
+}
+
 TEST(Dataset, RunNamesStartPosesAndSegmentsAreChecked) {
   const std::string csv = "t,cmd_left,cmd_right,x\n0,1,1,0\n";
   const auto withRun = [](const std::string& run) {
