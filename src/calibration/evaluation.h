@@ -74,9 +74,10 @@ std::set<std::string> usableGroups(const Dataset& ds);
 
 std::vector<int> allRuns(const Dataset& ds);
 
-/// How reproducible a drive run's replay is. The run is replayed a second time from a start moved
-/// by kStartNudge sigma of the tracker's noise (x, y and yaw), and the two predictions are compared
-/// in the channels' noise scales. The measured start is only known to that noise, so a replay that
+/// How reproducible a drive run's replay is. The run is replayed twice more, from starts moved by
+/// +kStartNudge and -kStartNudge sigma of the tracker's noise (x, y and yaw together), and each of
+/// those predictions is compared with the first in the channels' noise scales; the run's
+/// sensitivity is the larger of the two (a tipping threshold may lie on one side of the start only). The measured start is only known to that noise, so a replay that
 /// the data can test must not depend on where within it the start lies. A model whose motion
 /// depends smoothly on its start moves its prediction by far less than the noise (each replay's
 /// start-pose alignment absorbs the nudge: Simple's default runs move by at most 0.55); a chaotic
@@ -85,7 +86,7 @@ std::vector<int> allRuns(const Dataset& ds);
 /// trajectory happened to go, not which physics is missing, and no effect can fit them.
 struct ReplaySensitivity {
   int run = -1;                 ///< index into ds.runs
-  double nrms = 0;              ///< RMS of (nudged - first prediction) / sigma over every channel
+  double nrms = 0;              ///< RMS of (nudged - first prediction) / sigma over every channel, worse side
   std::string worst_channel;    ///< the channel that moved most
   double worst_nrms = 0;        ///< its RMS in noise units
 };

@@ -292,7 +292,7 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
   for (const auto& s : sums) any_drive |= !s.sensitivity.empty();
   if (any_drive) {
     md << "## Reproducibility of the replays\n\n"
-       << "Each drive run was replayed a second time from a start moved by " << kStartNudge
+       << "Each drive run was replayed twice more, from starts moved by +" << kStartNudge << " and -" << kStartNudge
        << " sigma of the tracker's noise (x, y, yaw). A run whose prediction then moves by more than " << kChaoticSensitivity
        << " of the noise (nRMS) is chaotic in that model: its residual shows where the simulated trajectory "
           "happened to go, not which physics is missing, and no effect can fit it. `diagnose` and `fit` leave such "

@@ -345,7 +345,7 @@ int cmdCompare(const Args& a) {
   for (const auto& s : sums) std::printf("%-28s %-60s %10.4f\n", s.label.c_str(), s.model.describe().c_str(), s.nrms);
   for (const auto& s : sums)
     if (const std::string chaotic = describeChaoticRuns(ds, s.sensitivity); !chaotic.empty())
-      std::printf("note: not reproducible under %s (a start %g sigma of the tracker noise away moves the prediction by more "
+      std::printf("note: not reproducible under %s (a start +-%g sigma of the tracker noise away moves the prediction by more "
                   "than %g noise): %s; their residuals are not evidence of a missing effect\n",
                   s.label.c_str(), kStartNudge, kChaoticSensitivity, chaotic.c_str());
   if (sums.size() > 1)
@@ -601,7 +601,7 @@ int cmdGenerate(const Args& a) {
   const ModelSpec true_model{g.level, truth.hidden};
   if (const std::string chaotic = describeChaoticRuns(ds, replaySensitivity(ds, true_model, eo, WorkerPool::global()));
       !chaotic.empty())
-    std::printf("note: the true model itself does not reproduce these runs (a start %g sigma of the tracker noise away "
+    std::printf("note: the true model itself does not reproduce these runs (a start +-%g sigma of the tracker noise away "
                 "moves them by more than %g noise): %s; leave them out (--families) to test effects on this level\n",
                 kStartNudge, kChaoticSensitivity, chaotic.c_str());
   return 0;

@@ -33,7 +33,9 @@ Dataset fastStraightsAndArcs() {
   g.level = "fast";
   g.seed = 3;
   g.experiments = {"straight", "arc"};
-  return generateDataset(g, WorkerPool::global());
+  // straight_60 reads 1.0 (pitch) from one side of its start, right at the chaos bar: the tests
+  // below are about the clear cases, smooth straights and tipping arcs.
+  return withoutRuns(generateDataset(g, WorkerPool::global()), {"straight_60"});
 }
 
 TEST(WorkerPool, MapsInWorkersLikeInline) {
@@ -144,7 +146,7 @@ TEST(ReplayableRuns, AreLeftOutAndReadmittedOnceASolvedModelReplaysThem) {
 
   const ReplayableRounds stays = solveOnReplayableRuns(ds, start, EvalOptions(), false, WorkerPool::global(), solvingTo({start}));
   EXPECT_EQ(stays.rounds, 1);
-  EXPECT_EQ(sizes, (std::vector<std::size_t>{3}));
+  EXPECT_EQ(sizes, (std::vector<std::size_t>{2}));
   EXPECT_EQ(stays.left_out, arcs);
   EXPECT_TRUE(stays.readmitted.empty());
   ASSERT_EQ(messages.size(), 1u);
@@ -155,13 +157,13 @@ TEST(ReplayableRuns, AreLeftOutAndReadmittedOnceASolvedModelReplaysThem) {
   EXPECT_EQ(back.rounds, 2);
   EXPECT_EQ(back.round, 2);
   EXPECT_TRUE(back.note.empty()) << back.note;
-  EXPECT_EQ(sizes, (std::vector<std::size_t>{3, 5}));
+  EXPECT_EQ(sizes, (std::vector<std::size_t>{2, 4}));
   EXPECT_TRUE(back.left_out.empty());
   EXPECT_EQ(back.readmitted, arcs);
   EXPECT_EQ(back.dataset.runs.size(), ds.runs.size());
   ASSERT_EQ(messages.size(), 2u);
   EXPECT_NE(messages[1].find("reproduces 2 of the 2 runs left out"), std::string::npos) << messages[1];
-  EXPECT_NE(messages[1].find("round 2 on 5 runs"), std::string::npos) << messages[1];
+  EXPECT_NE(messages[1].find("round 2 on 4 runs"), std::string::npos) << messages[1];
 
   // A round that loses an effect the round before found does not stand.
   const EffectConfig slower{"speed_scale", {{"scale", 0.9}}, {}, ""};
@@ -170,12 +172,12 @@ TEST(ReplayableRuns, AreLeftOutAndReadmittedOnceASolvedModelReplaysThem) {
   EXPECT_EQ(lost.rounds, 2);
   EXPECT_EQ(lost.round, 1);
   EXPECT_EQ(lost.left_out, arcs);
-  EXPECT_EQ(lost.dataset.runs.size(), 3u);
+  EXPECT_EQ(lost.dataset.runs.size(), 2u);
   EXPECT_NE(lost.note.find("round 2 ended without speed_scale, which round 1 found"), std::string::npos) << lost.note;
 
   const ReplayableRounds kept = solveOnReplayableRuns(ds, start, EvalOptions(), true, WorkerPool::global(), solvingTo({start}));
   EXPECT_EQ(kept.rounds, 1);
-  EXPECT_EQ(sizes, (std::vector<std::size_t>{5}));
+  EXPECT_EQ(sizes, (std::vector<std::size_t>{4}));
   EXPECT_TRUE(kept.left_out.empty());
   ASSERT_EQ(messages.size(), 1u);
   EXPECT_NE(messages[0].find("kept (--keep-chaotic)"), std::string::npos) << messages[0];
