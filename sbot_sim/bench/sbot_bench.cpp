@@ -49,7 +49,7 @@ Options parse(int argc, char** argv) {
     const std::string a = args.option();
     if (a == "--level") o.level = args.value();
     else if (a == "--seconds") o.seconds = args.number(0.001, 1e6);
-    else if (a == "--step") o.step = args.number(0, 1);  // 0: the level's recommended step
+    else if (a == "--step") o.step = args.number(sbot::kMinStep, sbot::kMaxStep);
     else if (a == "--chains") o.chains = args.count(0, sbot::kMaxRobots);
     else if (a == "--profile") o.profile = true;
     else if (a == "--robots") {

@@ -507,7 +507,7 @@ Dataset loadDatasetFields(const std::string& path_in) {
   } catch (const YAML::Exception& e) {
     throw DatasetError(f, e.mark.line + 1, e.mark.column + 1, "", "not valid YAML: " + e.msg);
   }
-  if (const std::string dup = duplicateKeyProblem(root); !dup.empty()) throw DatasetError(f, 0, 0, "", dup);
+  if (const std::string problem = yamlStructureProblem(root); !problem.empty()) throw DatasetError(f, 0, 0, "", problem);
   if (!root.IsMap()) throw DatasetError(f, 1, 1, "", "expected a mapping at the top level");
   allowOnly(root, f, "", {"format", "name", "description", "robot", "world", "noise", "runs", "surfaces",
                           "align_initial_pose", "align_segment", "generator"});

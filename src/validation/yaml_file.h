@@ -26,7 +26,8 @@ inline YAML::Node loadYamlFile(const std::string& what, const std::string& path)
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(what + " " + path + ": not YAML (" + e.msg + ", line " + std::to_string(e.mark.line + 1) + ")");
   }
-  if (const std::string dup = duplicateKeyProblem(root); !dup.empty()) throw std::runtime_error(what + " " + path + ": " + dup);
+  if (const std::string problem = yamlStructureProblem(root); !problem.empty())
+    throw std::runtime_error(what + " " + path + ": " + problem);
   return root;
 }
 

@@ -1,9 +1,11 @@
 #include "sbot_sim/core/robot_description.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <mutex>
+#include <set>
 #include <sstream>
 
 #include <urdf_parser/urdf_parser.h>
@@ -63,6 +65,8 @@ std::size_t countTags(const std::string& xml, const std::string& tag) {
   }
   return n;
 }
+
+constexpr double kMaxTorqueWindow = 10;  ///< [s] treels.torque_window
 
 void requirePositive(double v, const std::string& file, const std::string& field) {
   if (!(std::isfinite(v) && v > 0)) throw ConfigError(file, field, "must be a finite number > 0");
@@ -164,6 +168,124 @@ JointDescription convertJoint(const urdf::Joint& j, const std::string& file) {
   return out;
 }
 
+/// Keys of a sidecar mapping other than `allowed` are typos or leftovers: refused by name.
+void allowOnly(const YAML::Node& node, const std::vector<std::string>& allowed, const std::string& file,
+               const std::string& prefix) {
+  if (!node || !node.IsMap()) return;
+  for (const auto& kv : node) {
+    const std::string key = kv.first.as<std::string>();
+    if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
+    std::string list;
+    for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+    throw ConfigError(file, prefix + key, "unknown field (expected one of: " + list + ")");
+  }
+}
+
+/// The sidecar's `extra` entries: what each may hold. The modules read most of them (sensor
+/// constants, models, solver iterations); the counts of the seed's tables (ir_count, mic_count,
+/// led_groups, camera size, reading maxima) document the hardware and are checked all the same, so
+/// that an edited value is refused rather than silently meaning nothing.
+struct ExtraRule {
+  const char* key;
+  enum Kind { Choice, Flag, Number, Count } kind;
+  double lo = 0, hi = 0;           // Number: lo < v <= hi (lo_inclusive: lo <= v); Count: lo <= v <= hi
+  const char* choices = "";        // Choice: '|'-separated
+  bool lo_inclusive = false;
+};
+const std::vector<ExtraRule>& extraRules() {
+  using R = ExtraRule;
+  constexpr double kPi = 3.14159265358979323846;
+  static const std::vector<ExtraRule> rules{
+      {"ir_model", R::Choice, 0, 0, "lut|raytrace"},
+      {"camera", R::Choice, 0, 0, "fake|raw"},
+      {"sound_model", R::Choice, 0, 0, "simple|complex"},
+      {"light_ring", R::Choice, 0, 0, "leds|full"},
+      {"gripper", R::Choice, 0, 0, "none|sticky|jaws"},
+      {"treels_model", R::Choice, 0, 0, "two_wheels_casters|six_spheres|six_teethed_cylinders"},
+      {"ground_sensors", R::Flag},
+      {"side_arm", R::Flag},
+      {"dynamical_bodies", R::Count, 1, 100},
+      {"solver_iterations", R::Count, 0, 100000},  // 0: the world's
+      {"ir_count", R::Count, 1, 15},
+      {"ir_rays", R::Count, 1, 1000},
+      {"ground_rays", R::Count, 1, 1000},
+      {"mic_count", R::Count, 1, 3},
+      {"led_groups", R::Count, 1, 8},
+      {"led_max_units", R::Count, 1, 255},
+      {"camera_width", R::Count, 16, 4096},
+      {"camera_height", R::Count, 16, 4096},
+      {"ir_max_reading_units", R::Count, 1, 65535},
+      {"ground_max_reading_units", R::Count, 1, 65535},
+      {"ir_range_min_m", R::Number, 0, 1},
+      {"ir_range_max_m", R::Number, 0, 10},
+      {"ground_range_min_m", R::Number, 0, 1},
+      {"ground_range_max_m", R::Number, 0, 10},
+      {"ir_cone_angle_rad", R::Number, 0, kPi},
+      {"ground_cone_angle_rad", R::Number, 0, kPi},
+      {"ir_sensitivity_angle_rad", R::Number, 0, kPi},
+      {"fake_camera_vertical_angle_rad", R::Number, 0, kPi},
+      {"fake_camera_range_m", R::Number, 0, 1000},
+      {"ir_noise", R::Number, 0, 10, "", true},  // relative (0.1 = 10 %)
+      {"ground_noise", R::Number, 0, 10, "", true},
+      {"sound_noise", R::Number, 0, 10, "", true},
+      {"ir_fit_a", R::Number, -1e6, 1e6},  // eq. 2.5's log-log fit
+      {"ir_fit_b", R::Number, -1e6, 1e6},
+      {"ground_fit_a", R::Number, -1e6, 1e6},
+      {"ground_fit_b", R::Number, -1e6, 1e6},
+      {"led_unit_mcd", R::Number, 0, 1e6},
+      {"light_sensor_unit_mcd_cm2", R::Number, 0, 1e6},
+      {"light_sensor_max_units", R::Number, 0, 1e6},
+      {"blink_max_hz", R::Number, 0, 1e3},
+      {"friction_force_N", R::Number, 0, 1e3, "", true},
+      {"inertia_floor_kgm2", R::Number, 0, 1, "", true},
+  };
+  return rules;
+}
+
+void checkExtra(const YAML::Node& e, const std::string& file) {
+  if (!e.IsMap()) throw ConfigError(file, "extra", "expected a mapping of names to values");
+  const auto& rules = extraRules();
+  for (const auto& kv : e) {
+    const std::string key = kv.first.as<std::string>(), field = "extra." + key;
+    const auto rule = std::find_if(rules.begin(), rules.end(), [&](const ExtraRule& r) { return key == r.key; });
+    if (rule == rules.end()) {
+      std::string list;
+      for (const auto& r : rules) list += (list.empty() ? "" : ", ") + std::string(r.key);
+      throw ConfigError(file, field, "unknown field (expected one of: " + list + ")");
+    }
+    if (!kv.second.IsScalar()) throw ConfigError(file, field, "expected a single value");
+    const std::string text = kv.second.Scalar();
+    if (rule->kind == ExtraRule::Choice) {
+      const std::string choices = std::string("|") + rule->choices + "|";
+      if (choices.find("|" + text + "|") == std::string::npos)
+        throw ConfigError(file, field, "expected one of " + std::string(rule->choices) + ", found '" + text + "'");
+      continue;
+    }
+    if (rule->kind == ExtraRule::Flag) {
+      if (text != "true" && text != "false") throw ConfigError(file, field, "expected true or false, found '" + text + "'");
+      continue;
+    }
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    const bool number = !text.empty() && end && *end == '\0' && std::isfinite(v);
+    std::ostringstream range;
+    if (rule->kind == ExtraRule::Count) {
+      range << "a whole number in [" << rule->lo << ", " << rule->hi << "]";
+      if (!number || v != std::floor(v) || v < rule->lo || v > rule->hi)
+        throw ConfigError(file, field, "expected " + range.str() + ", found '" + text + "'");
+    } else {
+      range << "a finite number in " << (rule->lo_inclusive ? "[" : "(") << rule->lo << ", " << rule->hi << "]";
+      if (!number || v > rule->hi || v < rule->lo || (!rule->lo_inclusive && v == rule->lo))
+        throw ConfigError(file, field, "expected " + range.str() + ", found '" + text + "'");
+    }
+  }
+  for (const char* sensor : {"ir", "ground"}) {
+    const std::string lo = std::string(sensor) + "_range_min_m", hi = std::string(sensor) + "_range_max_m";
+    if (e[lo] && e[hi] && !(e[lo].as<double>() < e[hi].as<double>()))
+      throw ConfigError(file, "extra." + lo, "must be below extra." + hi);
+  }
+}
+
 template <typename T>
 T get(const YAML::Node& node, const std::string& key, const T& fallback, const std::string& file,
       const std::string& prefix) {
@@ -185,7 +307,10 @@ void parseSidecar(RobotDescription& d) {
   } catch (const YAML::Exception& e) {
     throw ConfigError(file, "", std::string("not valid YAML: ") + e.what());
   }
-  if (const std::string dup = duplicateKeyProblem(root); !dup.empty()) throw ConfigError(file, "", dup);
+  if (const std::string problem = yamlStructureProblem(root); !problem.empty()) throw ConfigError(file, "", problem);
+  if (!root.IsMap()) throw ConfigError(file, "", "expected a mapping at the top level");
+  allowOnly(root, {"level", "recommended_step", "gravity", "treels", "turret", "materials", "extra", "gripper", "side_arm"},
+            file, "");
   d.level = get<std::string>(root, "level", "", file, "");
   if (d.level.empty()) throw ConfigError(file, "level", "missing");
   d.recommended_step = get<double>(root, "recommended_step", 0.01, file, "");
@@ -224,6 +349,10 @@ void parseSidecar(RobotDescription& d) {
   nonNegative(tr.rotor_inertia, "treels.rotor_inertia");
   nonNegative(tr.backdrive_force, "treels.backdrive_force");
   nonNegative(tr.torque_window, "treels.torque_window");
+  // A buffer of torque_window / step samples per robot: 1e7 s took a node past 24 GB.
+  if (tr.torque_window > kMaxTorqueWindow)
+    throw ConfigError(file, "treels.torque_window", "must be <= " + std::to_string(static_cast<int>(kMaxTorqueWindow)) +
+                                                        " s (getTrackTorque's averaging window)");
   nonNegative(tr.creep_stiffness, "treels.creep_stiffness");
   requirePositive(tr.friction_scale, file, "treels.friction_scale");
   const std::string law = get<std::string>(t, "friction_law", "coulomb", file, "treels.");
@@ -272,6 +401,12 @@ void parseSidecar(RobotDescription& d) {
   if (const YAML::Node m = root["materials"]) {
     for (const auto& kv : m) {
       const auto link = kv.first.as<std::string>();
+      const std::string material = kv.second.IsScalar() ? kv.second.Scalar() : "";
+      if (!robotMaterials().count(material)) {
+        std::string list;
+        for (const auto& r : robotMaterials()) list += (list.empty() ? "" : ", ") + r;
+        throw ConfigError(file, "materials." + link, "unknown material '" + material + "' (materials: " + list + ")");
+      }
       bool found = false;
       for (auto& l : d.links) {
         if (l.name == link) {
@@ -282,8 +417,22 @@ void parseSidecar(RobotDescription& d) {
       if (!found) throw ConfigError(file, "materials." + link, "no such link in " + d.urdf_path);
     }
   }
+  if (const YAML::Node g = root["gripper"]) {
+    if (!g.IsMap()) throw ConfigError(file, "gripper", "expected a mapping");
+    const std::string type = get<std::string>(g, "type", "none", file, "gripper.");
+    if (type != "none" && type != "sticky" && type != "jaws")
+      throw ConfigError(file, "gripper.type", "expected none, sticky or jaws, found '" + type + "'");
+    for (const char* key : {"link", "tip_frame"})
+      if (g[key] && !d.findLink(get<std::string>(g, key, "", file, "gripper.")))
+        throw ConfigError(file, std::string("gripper.") + key, "no such link in " + d.urdf_path);
+    if (g["elevation_joint"] && !d.findJoint(get<std::string>(g, "elevation_joint", "", file, "gripper.")))
+      throw ConfigError(file, "gripper.elevation_joint", "no such joint in " + d.urdf_path);
+    for (const auto& j : get<std::vector<std::string>>(g, "jaw_joints", {}, file, "gripper."))
+      if (!d.findJoint(j)) throw ConfigError(file, "gripper.jaw_joints", "no joint '" + j + "' in " + d.urdf_path);
+  }
   // Everything else that is a scalar is kept as text for the modules that need it.
   if (const YAML::Node e = root["extra"]) {
+    checkExtra(e, file);
     for (const auto& kv : e) {
       if (kv.second.IsScalar()) d.extra[kv.first.as<std::string>()] = kv.second.as<std::string>();
     }
@@ -294,6 +443,11 @@ void parseSidecar(RobotDescription& d) {
 }
 
 }  // namespace
+
+const std::set<std::string>& robotMaterials() {
+  static const std::set<std::string> m{"chassis", "track", "caster", "stickable", "sticky", "body"};
+  return m;
+}
 
 const LinkDescription* RobotDescription::findLink(const std::string& name) const {
   for (const auto& l : links)
@@ -404,6 +558,10 @@ const RobotDescription& loadLevel(const std::string& level) {
   const std::string dir = descriptionDirectory() + "/urdf/";
   auto d = std::make_unique<RobotDescription>(
       loadRobotDescription(dir + level + ".urdf", dir + level + ".sbot.yaml"));
+  // The level names the robot in messages, topics and model switches: a copied sidecar that kept
+  // another level's name made a Simple robot report itself as Medium.
+  if (d->level != level)
+    throw ConfigError(d->sidecar_path, "level", "says '" + d->level + "' in the sidecar of level '" + level + "'");
   return *cache.emplace(level, std::move(d)).first->second;
 }
 

@@ -19,6 +19,7 @@ namespace {
 
 /// Seeds are whole numbers a double holds exactly.
 constexpr long long kMaxSeed = 1LL << 53;
+constexpr double kMaxGravity = 1000;  // [m/s^2]
 
 // Reads typed fields of one YAML mapping and reports errors with the full dotted field path.
 class Fields {
@@ -180,6 +181,9 @@ void parseTerrain(const YAML::Node& n, TerrainConfig& t, const std::string& file
       box.yaw = b.number("yaw", 0);
       box.pitch = b.number("pitch", 0);
       box.surface = b.text("surface", "ground");
+      for (const BoxObstacle& other : t.boxes)
+        if (other.name == box.name)
+          throw ConfigError(file, b.path("name"), "'" + box.name + "' names another box too (effects and reports name boxes)");
       t.boxes.push_back(box);
     }
   }
@@ -198,17 +202,18 @@ void parseTerrain(const YAML::Node& n, TerrainConfig& t, const std::string& file
 
 void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
   Fields f(n, "world", file);
-  // lamps / ambient_light are read by the simulator node (sensed environment, not physics).
+  // lamps / ambient_light: the sensed environment, not physics (parseSensedEnvironment).
   f.allowOnly({"step", "gravity", "solver", "solver_iterations", "solver_sor", "lock_idle_turret", "contact", "terrain",
                "lamps", "ambient_light"});
   w.solver = f.text("solver", w.solver);
   if (w.solver != "quickstep" && w.solver != "exact")
     throw ConfigError(file, f.path("solver"), "expected 'quickstep' or 'exact', found '" + w.solver + "'");
-  // [s] 0.1 ms to 0.5 s: below, a run of seconds takes millions of steps (a step given in the wrong
-  // unit); above, no level's contacts hold (the Fast level's 100 ms is the largest the seed uses).
-  w.step = f.within("step", w.step, 1e-4, 0.5);
+  w.step = f.within("step", w.step, kMinStep, kMaxStep);
   w.gravity = f.number("gravity", w.gravity);
   if (w.gravity < 0) throw ConfigError(file, f.path("gravity"), "must be >= 0 (its magnitude: gravity points along -z)");
+  if (w.gravity > kMaxGravity)
+    throw ConfigError(file, f.path("gravity"), "must be <= " + std::to_string(static_cast<int>(kMaxGravity)) +
+                                                   " m/s^2 (100 g; no contact holds beyond)");
   w.solver_iterations = static_cast<int>(f.integer("solver_iterations", w.solver_iterations, 1, 100000));
   w.solver_sor = f.positive("solver_sor", w.solver_sor);
   w.lock_idle_turret = f.flag("lock_idle_turret", w.lock_idle_turret);
@@ -234,6 +239,18 @@ void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
     }
   }
   parseTerrain(f.node("terrain"), w.terrain, file);
+  // A friction coefficient for a name nothing is made of would never apply (a typo, or a surface
+  // the terrain does not have): robots' materials, the library's surfaces and this terrain's.
+  std::set<std::string> names = robotMaterials();
+  for (const auto& s : knownSurfaces()) names.insert(s);
+  for (const auto& s : surfaceLabels(w.terrain)) names.insert(s);
+  for (const auto& [material, mu] : w.contact.material_mu)
+    if (!names.count(material)) {
+      std::string list;
+      for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+      throw ConfigError(file, "world.contact.materials." + material,
+                        "no robot material or terrain surface is called '" + material + "' (names: " + list + ")");
+    }
 }
 
 }  // namespace
@@ -255,6 +272,31 @@ void checkGravityOfLevels(const Scenario& s, const std::string& file) {
                                           "); the seed runs it alone (4.2.4)");
 }
 
+/// world.lamps and world.ambient_light, checked as Environment::addLamp / setAmbientLight would.
+void parseSensedEnvironment(const YAML::Node& world, Scenario& s, const std::string& file) {
+  Fields w(world, "world", file);
+  s.ambient_light = w.number("ambient_light", 0);
+  if (s.ambient_light < 0) throw ConfigError(file, w.path("ambient_light"), "must be >= 0 [mcd/cm^2]");
+  const YAML::Node lamps = w.node("lamps");
+  if (!lamps) return;
+  if (!lamps.IsSequence()) throw ConfigError(file, w.path("lamps"), "expected a list of {position, intensity, colour}");
+  for (std::size_t i = 0; i < lamps.size(); ++i) {
+    Fields l(lamps[i], "world.lamps[" + std::to_string(i) + "]", file);
+    l.allowOnly({"position", "intensity", "colour"});
+    if (!l.has("position")) throw ConfigError(file, l.path("position"), "missing (expected [x, y, z] in m)");
+    LampSpawn lamp;
+    lamp.position = l.vec3("position", lamp.position);
+    if (const std::string where = positionProblem(lamp.position); !where.empty())
+      throw ConfigError(file, l.path("position"), where);
+    lamp.intensity = l.number("intensity", 0);
+    if (lamp.intensity < 0) throw ConfigError(file, l.path("intensity"), "must be >= 0 [mcd]");
+    lamp.colour = l.vec3("colour", lamp.colour);
+    if (lamp.colour.minCoeff() < 0 || lamp.colour.maxCoeff() > 1)
+      throw ConfigError(file, l.path("colour"), "expected [r, g, b] in [0, 1]");
+    s.lamps.push_back(lamp);
+  }
+}
+
 Scenario parseScenario(const std::string& yaml_text, const std::string& file, int robot_count) {
   if (robot_count > kMaxRobots)
     throw ConfigError(file, "swarm.count", "robot count override " + std::to_string(robot_count) + " exceeds " +
@@ -265,7 +307,7 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
   } catch (const YAML::Exception& e) {
     throw ConfigError(file, "", "not valid YAML (line " + std::to_string(e.mark.line + 1) + "): " + e.msg);
   }
-  if (const std::string dup = duplicateKeyProblem(root); !dup.empty()) throw ConfigError(file, "", dup);
+  if (const std::string problem = yamlStructureProblem(root); !problem.empty()) throw ConfigError(file, "", problem);
   if (!root.IsMap()) throw ConfigError(file, "", "expected a mapping at the top level");
   Fields f(root, "", file);
   f.allowOnly({"seed", "duration", "world", "robots", "swarm", "links", "name", "description", "effects"});
@@ -280,6 +322,7 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
   }
   if (s.duration < 0) throw ConfigError(file, "duration", "must be >= 0");
   parseWorld(f.node("world"), s.world, file);
+  parseSensedEnvironment(f.node("world"), s, file);
 
   if (const YAML::Node robots = f.node("robots")) {
     if (!robots.IsSequence()) throw ConfigError(file, "robots", "expected a list");
@@ -437,7 +480,20 @@ std::string scenarioYaml(const Scenario& sc, const std::string& name, const std:
     }
     e << YAML::EndSeq;
   }
-  e << YAML::EndMap << YAML::EndMap;  // terrain, world
+  e << YAML::EndMap;  // terrain
+  if (sc.ambient_light != 0) e << YAML::Key << "ambient_light" << YAML::Value << num(sc.ambient_light);
+  if (!sc.lamps.empty()) {
+    e << YAML::Key << "lamps" << YAML::Value << YAML::BeginSeq;
+    for (const LampSpawn& l : sc.lamps) {
+      e << YAML::Flow << YAML::BeginMap << YAML::Key << "position" << YAML::Value;
+      vec3(l.position);
+      e << YAML::Key << "intensity" << YAML::Value << num(l.intensity) << YAML::Key << "colour" << YAML::Value;
+      vec3(l.colour);
+      e << YAML::EndMap;
+    }
+    e << YAML::EndSeq;
+  }
+  e << YAML::EndMap;  // world
   e << YAML::Key << "robots" << YAML::Value << YAML::BeginSeq;
   for (const RobotSpawn& r : sc.robots) {
     e << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << r.name << YAML::Key << "level"

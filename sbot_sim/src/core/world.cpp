@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <mutex>
 #include <sstream>
@@ -499,6 +500,79 @@ void rayCallback(void* data, dGeomID o1, dGeomID o2) {
 }
 
 }  // namespace
+
+namespace {
+
+struct OverlapQuery {
+  const Robot* robot;
+  World::Overlap* deepest;
+};
+
+void overlapCallback(void* data, dGeomID o1, dGeomID o2) {
+  auto& q = *static_cast<OverlapQuery*>(data);
+  if (o1 == o2) return;  // the robot's own space, met inside the world's
+  if (dGeomIsSpace(o1) || dGeomIsSpace(o2)) {
+    dSpaceCollide2(o1, o2, data, &overlapCallback);
+    return;
+  }
+  const GeomInfo *a = infoOf(o1), *b = infoOf(o2);
+  const bool a_own = a && a->robot == q.robot, b_own = b && b->robot == q.robot;
+  if (a_own == b_own) return;  // two of its own geoms (its joints decide), or neither
+  dContactGeom c[4];
+  const int n = dCollide(o1, o2, 4, c, sizeof(dContactGeom));
+  const GeomInfo* other = a_own ? b : a;
+  for (int i = 0; i < n; ++i) {
+    if (c[i].depth <= q.deepest->depth) continue;
+    q.deepest->depth = c[i].depth;
+    if (other && other->robot) q.deepest->with = "robot '" + other->robot->name() + "'";
+    else if (other && other->material != kGround) q.deepest->with = "box '" + other->link + "'";
+    else q.deepest->with = "the ground";
+  }
+}
+
+}  // namespace
+
+World::Overlap World::deepestOverlap(const Robot& robot) const {
+  Overlap deepest;
+  OverlapQuery q{&robot, &deepest};
+  const dGeomID own = reinterpret_cast<dGeomID>(robot.space());
+  dSpaceCollide2(own, reinterpret_cast<dGeomID>(static_space_), &q, &overlapCallback);
+  dSpaceCollide2(own, reinterpret_cast<dGeomID>(space_), &q, &overlapCallback);
+  return deepest;
+}
+
+std::string World::placeRobot(Robot& robot, const Pose& pose) {
+  struct BodyState {
+    dVector3 position, linear, angular;
+    dQuaternion orientation;
+  };
+  std::vector<BodyState> before(robot.bodies().size());
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    const dBodyID b = robot.bodies()[i];
+    BodyState& s = before[i];
+    for (int k = 0; k < 3; ++k) {
+      s.position[k] = dBodyGetPosition(b)[k];
+      s.linear[k] = dBodyGetLinearVel(b)[k];
+      s.angular[k] = dBodyGetAngularVel(b)[k];
+    }
+    for (int k = 0; k < 4; ++k) s.orientation[k] = dBodyGetQuaternion(b)[k];
+  }
+  robot.setBasePose(pose);
+  const Overlap o = deepestOverlap(robot);
+  if (o.depth <= kPlacementTolerance) return "";
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    const dBodyID b = robot.bodies()[i];
+    const BodyState& s = before[i];
+    dBodySetPosition(b, s.position[0], s.position[1], s.position[2]);
+    dBodySetQuaternion(b, s.orientation);
+    dBodySetLinearVel(b, s.linear[0], s.linear[1], s.linear[2]);
+    dBodySetAngularVel(b, s.angular[0], s.angular[1], s.angular[2]);
+  }
+  std::ostringstream why;
+  why << "robot '" << robot.name() << "' there would sit " << std::fixed << std::setprecision(3) << o.depth
+      << " m deep inside " << o.with << " (at most " << kPlacementTolerance << " m): not moved";
+  return why.str();
+}
 
 dGeomID World::queryRay(double length) const {
   if (!query_ray_) {

@@ -1,27 +1,58 @@
 #include "sbot_sim/core/yaml_checks.h"
 
 #include <map>
+#include <vector>
 
 namespace sbot {
+namespace {
 
-std::string duplicateKeyProblem(const YAML::Node& node) {
+/// Nodes visited with aliases expanded. yaml-cpp shares an aliased node instead of copying it, so a
+/// file of a few lines can stand for 10^11 nodes ("billion laughs"); no configuration comes near.
+constexpr long kMaxExpandedNodes = 1000000;
+
+struct Walk {
+  std::vector<YAML::Node> ancestors;  // the path from the root: an alias to one of them is a cycle
+  long visited = 0;
+};
+
+std::string problemIn(const YAML::Node& node, Walk& w) {
+  if (++w.visited > kMaxExpandedNodes)
+    return "more than " + std::to_string(kMaxExpandedNodes) +
+           " values once its aliases (*name) are expanded: aliases nested to multiply a document are refused";
+  for (const YAML::Node& a : w.ancestors)
+    if (a.is(node))
+      return "an alias refers to a value that contains it (anchor at line " + std::to_string(node.Mark().line + 1) +
+             "): recursive YAML is refused";
+  if (!node.IsSequence() && !node.IsMap()) return "";
+  w.ancestors.push_back(node);
+  std::string problem;
   if (node.IsSequence()) {
     for (const auto& item : node)
-      if (std::string p = duplicateKeyProblem(item); !p.empty()) return p;
-  } else if (node.IsMap()) {
+      if (problem = problemIn(item, w); !problem.empty()) break;
+  } else {
     std::map<std::string, int> first_line;
     for (const auto& kv : node) {
       if (kv.first.IsScalar()) {
         const int line = kv.first.Mark().line + 1;
         const auto [it, fresh] = first_line.emplace(kv.first.Scalar(), line);
-        if (!fresh)
-          return "key '" + kv.first.Scalar() + "' appears twice in one mapping (lines " + std::to_string(it->second) +
-                 " and " + std::to_string(line) + ")";
+        if (!fresh) {
+          problem = "key '" + kv.first.Scalar() + "' appears twice in one mapping (lines " + std::to_string(it->second) +
+                    " and " + std::to_string(line) + ")";
+          break;
+        }
       }
-      if (std::string p = duplicateKeyProblem(kv.second); !p.empty()) return p;
+      if (problem = problemIn(kv.second, w); !problem.empty()) break;
     }
   }
-  return "";
+  w.ancestors.pop_back();
+  return problem;
+}
+
+}  // namespace
+
+std::string yamlStructureProblem(const YAML::Node& node) {
+  Walk w;
+  return problemIn(node, w);
 }
 
 }  // namespace sbot

@@ -67,6 +67,20 @@ TEST(EffectsFile, ErrorsNameTheField) {
   EXPECT_EQ(fieldOf("effects: [{name: latency, params: {delay: 0.1}}, {name: latency, delay: 1}]"), "effects[1].delay");
   EXPECT_EQ(fieldOf("effects:\n  - name: latency\n    name: speed_scale\n"), "") << "a repeated key names the file";
   EXPECT_THROW(loadEffectsFile("/nonexistent/effects.yaml"), ConfigError);
+  // A folder read as an empty stream: "no effects" (an outside probe, 2026-11-29).
+  try {
+    loadEffectsFile("/tmp");
+    ADD_FAILURE() << "a folder was read as an effects file";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a folder, not an effects file"), std::string::npos) << e.what();
+  }
+  // A dimensionless parameter's unit "1" read as part of the value ("value -1 1 is outside").
+  try {
+    makeEffects(parseEffectsConfig("effects: [{name: speed_scale, params: {scale: -1}}]", "e.yaml"));
+    ADD_FAILURE() << "scale -1 was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("value -1 is outside the physical bounds ["), std::string::npos) << e.what();
+  }
 }
 
 // A per-surface parameter whose label names no surface would never act: the simulator node loaded

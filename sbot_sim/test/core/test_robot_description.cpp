@@ -179,5 +179,40 @@ TEST(RobotDescription, SensorExtrasMustBeFiniteAndRayCountsWhole) {
   EXPECT_THROW(sensors::extraNumber(d, "ir_noise", 0.1), ConfigError);
 }
 
+
+// An outside probe (2026-11-29): an `extra` value a module reads late aborted the node from inside
+// its sensor set-up (std::terminate), others were never read and any value passed, a window of
+// 1e7 s took the node past 24 GB, and a copied sidecar's level or material went unnoticed. Each is
+// now refused when the sidecar loads, naming the field and what it expects.
+TEST(RobotDescription, SidecarEntriesAreCheckedWhenTheyLoad) {
+  const std::pair<std::string, std::string> cases[][2] = {
+      {{"ir_model: lut", "ir_model: psychic"}, {"extra.ir_model", "expected one of lut|raytrace, found 'psychic'"}},
+      {{"ir_range_max_m: 0.2", "ir_range_max_m: -0.2"}, {"extra.ir_range_max_m", "expected a finite number in (0, 10]"}},
+      {{"ir_rays: 5", "ir_rays: 0"}, {"extra.ir_rays", "expected a whole number in [1, 1000], found '0'"}},
+      {{"ir_rays: 5", "ir_rays: 1000000000"}, {"extra.ir_rays", "expected a whole number in [1, 1000]"}},
+      {{"ir_count: 15", "ir_count: 0"}, {"extra.ir_count", "expected a whole number in [1, 15]"}},
+      {{"ir_noise: 0.1", "ir_noise: -1"}, {"extra.ir_noise", "expected a finite number in [0, 10]"}},
+      {{"ir_fit_a: 8.44352", "ir_fit_a: .nan"}, {"extra.ir_fit_a", "found '.nan'"}},
+      {{"light_sensor_max_units: 700", "light_sensor_max_units: 0"}, {"extra.light_sensor_max_units", "(0, 1e+06]"}},
+      {{"dynamical_bodies: 4", "dynamical_bodies: -4"}, {"extra.dynamical_bodies", "[1, 100]"}},
+      {{"  camera: fake", "  camera: x"}, {"extra.camera", "expected one of fake|raw"}},
+      {{"ground_sensors: false", "ground_sensors: maybe"}, {"extra.ground_sensors", "expected true or false"}},
+      {{"ir_model: lut", "ir_model: lut\n  bogus_key: 1"}, {"extra.bogus_key", "unknown field"}},
+      {{"ir_range_min_m: 0.002", "ir_range_min_m: 0.5"}, {"extra.ir_range_min_m", "must be below extra.ir_range_max_m"}},
+      {{"torque_window: 0.1", "torque_window: 1e7"}, {"treels.torque_window", "must be <= 10 s"}},
+      {{"base_link: chassis", "base_link: unobtainium"}, {"materials.base_link", "unknown material 'unobtainium'"}},
+      {{"{type: none,", "{type: claw,"}, {"gripper.type", "expected none, sticky or jaws, found 'claw'"}},
+      {{"tip_frame: gripper_tip", "tip_frame: nowhere"}, {"gripper.tip_frame", "no such link"}},
+      {{"level: simple", "level: simple\nwheels: 6"}, {"wheels", "unknown field"}},
+  };
+  for (const auto& c : cases) {
+    BrokenCopy copy;
+    copy.breakSidecar(c[0].first, c[0].second);
+    const std::string e = copy.loadError();
+    EXPECT_NE(e.find("simple.sbot.yaml: field '" + c[1].first + "': "), std::string::npos) << c[0].second << ": " << e;
+    EXPECT_NE(e.find(c[1].second), std::string::npos) << c[0].second << ": " << e;
+  }
+}
+
 }  // namespace
 }  // namespace sbot

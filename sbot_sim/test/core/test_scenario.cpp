@@ -84,11 +84,33 @@ TEST(Scenario, RefusesValuesThatWouldMisbehaveLater) {
   // yaml-cpp keeps both copies of a repeated key and reads the first: the second was lost silently.
   refused("seed: 1\nworld:\n  step: 0.01\n  step: 0.1\n", "key 'step' appears twice in one mapping (lines 3 and 4)");
   refused("robots: [{name: a, x: 0, x: 1}]", "key 'x' appears twice");
+  // An alias inside the value it names overflowed the stack of every loader; aliases nested ten deep
+  // ("billion laughs", 10^11 values) walked for hours. Every loader runs the same check.
+  refused("extra: &e [*e]", "an alias refers to a value that contains it (anchor at line 1)");
+  refused("world: &w {terrain: *w}", "an alias refers to a value that contains it");
+  std::string laughs = "l0: &l0 [0, 0, 0, 0, 0, 0, 0, 0, 0, 0]\n";
+  for (int i = 1; i <= 10; ++i) {
+    laughs += "l" + std::to_string(i) + ": &l" + std::to_string(i) + " [";
+    for (int k = 0; k < 10; ++k) laughs += (k ? ", *l" : "*l") + std::to_string(i - 1);
+    laughs += "]\n";
+  }
+  refused(laughs, "more than 1000000 values once its aliases (*name) are expanded");
+  // A plain alias (the same value used twice) is still allowed.
+  EXPECT_EQ(parseScenario("world: {step: &s 0.01}\nswarm: {count: 0}\n", "ok.yaml").world.step, 0.01);
   refused("world: {contact: {erp: 5}}", "'world.contact.erp': must be in [0, 1], found 5");
   refused("world: {contact: {cfm: -1}}", "'world.contact.cfm': must be >= 0");
   refused("world: {contact: {bounce: 2}}", "'world.contact.bounce': must be in [0, 1]");
   refused("world: {contact: {max_contacts: 17}}", "'world.contact.max_contacts': must be a whole number in [1, 16]");
   refused("world: {contact: {materials: {track: -1}}}", "'world.contact.materials.track': must be >= 0");
+  // A coefficient for a name nothing is made of never applied (an outside probe, 2026-11-29).
+  refused("world: {contact: {materials: {lava: 1}}}", "'world.contact.materials.lava': no robot material or terrain surface");
+  EXPECT_EQ(parseScenario("world: {contact: {materials: {lava: 0.2}}, terrain: {type: composite, boxes: "
+                          "[{center: [1, 0, 0.05], size: [0.1, 0.1, 0.1], surface: lava}]}}",
+                          "ok.yaml").world.contact.material_mu.at("lava"), 0.2)
+      << "a surface of this terrain may have its own coefficient";
+  refused("world: {terrain: {type: composite, boxes: [{name: a, center: [1, 0, 0]}, {name: a, center: [2, 0, 0]}]}}",
+          "'world.terrain.boxes[1].name': 'a' names another box too");
+  refused("world: {gravity: 1e30}", "'world.gravity': must be <= 1000 m/s^2");
   refused("swarm: {count: 2, center: [0, .nan]}", "'swarm.center': must be finite");
   refused("swarm: {count: 2, center: [0, here]}", "'swarm.center': expected [x, y] of numbers");
   refused("world: {terrain: {type: composite, boxes: [{center: [0, 0]}]}}", "'world.terrain.boxes[0].center': expected [x, y, z]");
@@ -139,6 +161,29 @@ TEST(Scenario, PositionsOutsideTheSimulatedSpaceAreRefused) {
   EXPECT_THROW(World{c}, ConfigError);
 }
 
+// /sim/set_pose put a robot 5 m under the floor and reported success; it then rose through the
+// ground at 0.5 m/s. placeRobot refuses a pose that buries it in the ground or another robot, and
+// leaves the robot as it was.
+TEST(Scenario, ARobotIsNotPlacedInsideTheGroundOrAnotherRobot) {
+  for (const std::string level : {"simple", "medium", "detailed"}) {
+    World w(WorldConfig{});
+    Robot& a = w.addRobot(loadLevel(level), {0, 0, 0}, "a");
+    Robot& b = w.addRobot(loadLevel(level), {0.5, 0, 0}, "b");
+    w.stepN(50);
+    const Pose settled = a.basePose();
+    EXPECT_LE(w.deepestOverlap(a).depth, World::kPlacementTolerance) << level << ": settled on the floor";
+    const std::string under = w.placeRobot(a, Pose(Vec3(1, 1, -5), Quat::Identity()));
+    EXPECT_NE(under.find("robot 'a' there would sit"), std::string::npos) << level << ": " << under;
+    EXPECT_NE(under.find("inside the ground"), std::string::npos) << level << ": " << under;
+    EXPECT_TRUE(a.basePose().position.isApprox(settled.position, 1e-12)) << level << ": not moved";
+    const Pose on_b(b.basePose().position, Quat::Identity());
+    EXPECT_NE(w.placeRobot(a, on_b).find("inside robot 'b'"), std::string::npos) << level;
+    // The same height a metre away is free.
+    EXPECT_EQ(w.placeRobot(a, Pose(settled.position + Vec3(1, 1, 0), settled.orientation)), "") << level;
+    EXPECT_TRUE(a.basePose().position.isApprox(settled.position + Vec3(1, 1, 0), 1e-9)) << level;
+  }
+}
+
 // The same rule guards the other way robots enter a world (the node's /sim/spawn, tools).
 TEST(Scenario, TheWorldRefusesRobotNamesRosCannotUse) {
   World w(WorldConfig{});
@@ -175,6 +220,8 @@ world:
     boxes:
       - {name: ramp, center: [0.1234567891, -0.2, 0.05], size: [0.6, 1.0, 0.05], yaw: 0.3, pitch: -0.7, surface: white_paper}
       - {name: step, center: [0.5, 0, 0.01], size: [1, 1, 0.02]}
+  ambient_light: 0.25
+  lamps: [{position: [1, 2, 0.3], intensity: 5000, colour: [1, 0.5, 0]}]
 robots:
   - {name: holder, level: medium, pose: {x: -0.12, y: 0.003, yaw: 3.1}}
   - {name: held, level: medium, pose: {x: 0.2, y: 0, yaw: 0}}
@@ -218,6 +265,40 @@ links: [{holder: holder, held: held, kind: side_arm}]
   ASSERT_EQ(b.links.size(), 1u);
   EXPECT_EQ(b.links[0].holder, "holder");
   EXPECT_EQ(b.links[0].kind, 2);
+  EXPECT_DOUBLE_EQ(b.ambient_light, 0.25);
+  ASSERT_EQ(b.lamps.size(), 1u);
+  EXPECT_EQ(b.lamps[0].position, Vec3(1, 2, 0.3));
+  EXPECT_DOUBLE_EQ(b.lamps[0].intensity, 5000);
+  EXPECT_EQ(b.lamps[0].colour, Vec3(1, 0.5, 0));
+}
+
+// The sensed environment was read by the node alone: an infinite ambient light aborted it, NaN and
+// negative values became 0 without a word, and a bad lamp dropped it and the lamps after it.
+TEST(Scenario, LampsAndAmbientLightAreCheckedByField) {
+  const auto refused = [](const std::string& yaml, const std::string& expected) {
+    const std::string e = errorOf(yaml);
+    EXPECT_NE(e.find(expected), std::string::npos) << yaml << "\n  gave: '" << e << "'";
+  };
+  refused("world: {ambient_light: .inf}", "'world.ambient_light': must be finite");
+  refused("world: {ambient_light: .nan}", "'world.ambient_light': must be finite");
+  refused("world: {ambient_light: -100}", "'world.ambient_light': must be >= 0");
+  refused("world: {ambient_light: bright}", "'world.ambient_light': expected a number, found 'bright'");
+  const std::string ok = "{position: [0, 0, 1], intensity: 10}";
+  refused("world: {lamps: [" + ok + ", {position: [0, 0, 1], intensity: .nan}]}", "'world.lamps[1].intensity': must be finite");
+  refused("world: {lamps: [{position: [0, 0, 1], intensity: -1}]}", "'world.lamps[0].intensity': must be >= 0");
+  refused("world: {lamps: [{position: [0.8], intensity: 1}]}", "'world.lamps[0].position': expected [x, y, z]");
+  refused("world: {lamps: [{intensity: 1}]}", "'world.lamps[0].position': missing");
+  refused("world: {lamps: [{position: [1e9, 0, 1]}]}", "'world.lamps[0].position'");
+  refused("world: {lamps: [{position: [0, 0, 1], colour: [1]}]}", "'world.lamps[0].colour': expected [x, y, z]");
+  refused("world: {lamps: [{position: [0, 0, 1], colour: red}]}", "'world.lamps[0].colour': expected [x, y, z]");
+  refused("world: {lamps: [{position: [0, 0, 1], colour: [.nan, 0, 0]}]}", "'world.lamps[0].colour': must be finite");
+  refused("world: {lamps: [{position: [0, 0, 1], colour: [2, 0, 0]}]}", "'world.lamps[0].colour': expected [r, g, b] in [0, 1]");
+  refused("world: {lamps: [{position: [0, 0, 1], brightness: 5}]}", "'world.lamps[0].brightness': unknown field");
+  refused("world: {lamps: {a: 1}}", "'world.lamps': expected a list");
+  refused("world: {lamps: [7]}", "'world.lamps[0]': expected a mapping");
+  const Scenario s = parseScenario("world: {ambient_light: 0.5, lamps: [" + ok + ", " + ok + "]}", "ok.yaml");
+  EXPECT_EQ(s.lamps.size(), 2u);
+  EXPECT_DOUBLE_EQ(s.ambient_light, 0.5);
 }
 
 TEST(Scenario, RoughTerrainIsWrittenSquareOrRefused) {

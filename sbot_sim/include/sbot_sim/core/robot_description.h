@@ -5,6 +5,7 @@
 #pragma once
 
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -122,6 +123,10 @@ RobotDescription loadRobotDescription(const std::string& urdf_path, const std::s
 /// Directory holding `urdf/<level>.urdf` and `urdf/<level>.sbot.yaml`: $SBOT_DESCRIPTION_DIR if
 /// set, otherwise the sbot_description source directory this library was built against.
 std::string descriptionDirectory();
+
+/// The contact materials a robot's links can be made of (sidecar `materials`; README of
+/// sbot_description): a scenario's contact.materials may name these and the terrain's surfaces.
+const std::set<std::string>& robotMaterials();
 
 /// The five model levels, cheapest first.
 const std::vector<std::string>& modelLevels();

@@ -15,8 +15,8 @@
 //     - {name: sbot_0, level: simple, pose: {x: 0, y: 0, yaw: 0}}   # name: see robotNameProblem
 //   swarm:                        # ... and/or generated ones, named sbot_<i> after the explicit ones
 //     {count: 20, level: simple, layout: grid, spacing: 0.3, center: [0, 0]}   # layout grid|random
-//   world.lamps: [{position: [x, y, z], intensity: mcd, colour: [r, g, b]}]   # read by the node
-//   world.ambient_light: 0.0      # [mcd/cm^2], read by the node (sensors/environment.h)
+//   world.lamps: [{position: [x, y, z], intensity: mcd, colour: [r, g, b]}]   # the sensed environment
+//   world.ambient_light: 0.0      # [mcd/cm^2] (sensors/environment.h)
 //   links:                        # static connections (seed 2.2.3), made at start (and at reset):
 //     - {holder: sbot_1, held: sbot_0, kind: front_gripper}   # kind front_gripper | side_arm;
 //                                 # held is moved to holder's gripper_tip (see core/swarm/swarm_graph.h)
@@ -40,6 +40,13 @@ struct RobotSpawn {
   Pose2D pose;
 };
 
+/// A lamp of the sensed environment (`world.lamps[]`, sensors/environment.h Environment::addLamp).
+struct LampSpawn {
+  Vec3 position = Vec3::Zero();  ///< [m]
+  double intensity = 0;          ///< [mcd] (milli-candela, the seed's light unit), >= 0
+  Vec3 colour = Vec3::Ones();    ///< RGB in [0, 1], as the camera sees it
+};
+
 /// A static link of the scenario's `links` list (core/swarm/swarm_graph.h createStaticLink).
 struct LinkSpawn {
   std::string holder, held;
@@ -51,6 +58,8 @@ struct Scenario {
   WorldConfig world;
   std::vector<RobotSpawn> robots;
   std::vector<LinkSpawn> links;  ///< after the robots; every name is one of `robots`
+  std::vector<LampSpawn> lamps;  ///< world.lamps: what the light sensors and the camera see
+  double ambient_light = 0;      ///< world.ambient_light [mcd/cm^2], >= 0
   double duration = 0;           ///< [s], 0 = unlimited
   /// Effects file (`effects: FILE`, relative to the scenario): the calibration workbench's format,
   /// so an accepted effect becomes part of the simulation. Empty = none.

@@ -96,6 +96,19 @@ class World {
   std::vector<RayHit> castRayBundles(const std::vector<Vec3>& origins, const std::vector<Vec3>& directions,
                                      double length, const Robot* ignore) const;
 
+  /// The deepest overlap of `robot`'s geoms with the terrain or another robot as it stands now.
+  struct Overlap {
+    double depth = 0;  ///< [m] ODE's penetration depth; 0 when nothing overlaps
+    std::string with;  ///< "the ground", "box 'step'" or "robot 'sbot_3'"
+  };
+  Overlap deepestOverlap(const Robot& robot) const;
+  /// Teleport `robot` (Robot::setBasePose: base_link at `pose`, at rest) unless it would then sit
+  /// deeper than kPlacementTolerance inside the terrain or another robot, which the contacts would
+  /// resolve by throwing it out (a robot set 5 m under the floor rose through it at 0.5 m/s). Returns
+  /// "" when placed; otherwise why not, and the robot is left exactly as it was.
+  static constexpr double kPlacementTolerance = 0.01;  ///< [m] a robot set down slightly low settles
+  std::string placeRobot(Robot& robot, const Pose& pose);
+
   void addEffect(EffectPtr effect) { effects_.push_back(std::move(effect)); }
   const std::vector<EffectPtr>& effects() const { return effects_; }
   void clearEffects() { effects_.clear(); }

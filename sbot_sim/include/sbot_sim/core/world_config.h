@@ -12,6 +12,11 @@
 
 namespace sbot {
 
+/// [s] the integration steps a world accepts: below, a run of seconds takes millions of steps (a
+/// step given in the wrong unit; per-robot buffers sized window / step run out of memory); above,
+/// no level's contacts hold (the Fast level's 100 ms is the largest the seed uses).
+constexpr double kMinStep = 1e-4, kMaxStep = 0.5;
+
 /// Contact model. Materials are named by the sidecar (`materials`) and by obstacles (`surface`).
 struct ContactConfig {
   /// Coulomb coefficient of any contact without a listed material: the s-bot's plastic turret and
@@ -69,7 +74,7 @@ struct TerrainConfig {
 std::set<std::string> surfaceLabels(const TerrainConfig& terrain);
 
 struct WorldConfig {
-  double step = 0.01;          ///< fixed integration step [s]
+  double step = 0.01;          ///< fixed integration step [s], in [kMinStep, kMaxStep]
   double gravity = 9.81;       ///< [m/s^2], pointing -z
   /// ODE stepper. "quickstep" (default): iterative, the validated configuration. "exact":
   /// dWorldStep's direct LCP solve per island: no yaw drift for Simple/Basic/Medium and faster for

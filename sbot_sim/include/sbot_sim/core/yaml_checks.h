@@ -7,10 +7,14 @@
 
 namespace sbot {
 
-/// The first key repeated within one mapping anywhere in `node`, as "key 'k' appears twice in one
-/// mapping (lines L1 and L2)", or "" if there is none. yaml-cpp keeps both copies and answers
-/// node["k"] with the first, so a repeated key silently loses the value written last (a second
-/// `report:` in a tables file dropped a whole table).
-std::string duplicateKeyProblem(const YAML::Node& node);
+/// What yaml-cpp accepts but no configuration file may hold, or "" if nothing:
+/// - a key repeated within one mapping, as "key 'k' appears twice in one mapping (lines L1 and L2)":
+///   yaml-cpp keeps both copies and answers node["k"] with the first, so the value written last is
+///   silently lost (a second `report:` in a tables file dropped a whole table);
+/// - an alias inside the value it names (`a: &x [*x]`), which made every walk of the tree recurse
+///   until the stack overflowed;
+/// - aliases nested to multiply the document past a million values ("billion laughs"), which made
+///   a walk run for hours.
+std::string yamlStructureProblem(const YAML::Node& node);
 
 }  // namespace sbot

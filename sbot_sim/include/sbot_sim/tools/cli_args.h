@@ -19,7 +19,9 @@ inline double numberArg(const char* tool, const std::string& option, const std::
                         double max) {
   char* end = nullptr;
   const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || !std::isfinite(v) || v < min || v > max) {
+  // strtod also reads hexadecimal ("0x10" = 16), which no one means on a command line.
+  const bool hex = text.find_first_of("xX") != std::string::npos;
+  if (text.empty() || *end != '\0' || hex || !std::isfinite(v) || v < min || v > max) {
     std::fprintf(stderr, "%s: %s expects a number in [%g, %g], found '%s'\n", tool, option.c_str(), min, max,
                  text.c_str());
     std::exit(2);

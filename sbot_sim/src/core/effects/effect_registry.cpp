@@ -101,8 +101,9 @@ ParametricEffectPtr EffectRegistry::create(const std::string& name, const std::m
     if (!std::isfinite(v)) throw ConfigError(source, pfield + "." + k, "must be a finite number");
     if (v < s->lower || v > s->upper) {
       std::ostringstream msg;
-      msg << "value " << v << " " << s->unit << " is outside the physical bounds [" << s->lower << ", "
-          << s->upper << "]";
+      // Dimensionless parameters have unit "1", which read as part of the value ("value -1 1").
+      const std::string unit = s->unit == "1" || s->unit.empty() ? "" : " " + s->unit;
+      msg << "value " << v << unit << " is outside the physical bounds [" << s->lower << ", " << s->upper << "]" << unit;
       throw ConfigError(source, pfield + "." + k, msg.str());
     }
   }

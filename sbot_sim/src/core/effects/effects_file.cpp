@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include <sys/stat.h>
 #include <yaml-cpp/yaml.h>
 
 #include "sbot_sim/core/yaml_checks.h"
@@ -52,7 +53,7 @@ std::vector<EffectConfig> parseEffectsConfig(const std::string& yaml_text, const
   } catch (const YAML::Exception& e) {
     throw ConfigError(src, "", "not valid YAML (line " + std::to_string(e.mark.line + 1) + "): " + e.msg);
   }
-  if (const std::string dup = duplicateKeyProblem(root); !dup.empty()) throw ConfigError(src, "", dup);
+  if (const std::string problem = yamlStructureProblem(root); !problem.empty()) throw ConfigError(src, "", problem);
   std::vector<EffectConfig> out;
   if (!root || root.IsNull()) return out;  // an empty file = no effects
   if (!root.IsMap()) throw ConfigError(src, "", "expected a mapping with an 'effects' list");
@@ -101,6 +102,9 @@ std::vector<EffectConfig> parseEffectsConfig(const std::string& yaml_text, const
 }
 
 std::vector<EffectConfig> loadEffectsConfig(const std::string& path) {
+  // A folder opens as a stream that reads nothing, which would be "no effects".
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) throw ConfigError(path, "", "is a folder, not an effects file");
   std::ifstream in(path);
   if (!in) throw ConfigError(path, "", "cannot open effects file");
   std::stringstream ss;
