@@ -18,8 +18,8 @@
 #include <sensor_msgs/Illuminance.h>
 #include <sensor_msgs/Range.h>
 #include <visualization_msgs/MarkerArray.h>
-#include <yaml-cpp/yaml.h>
 
+#include "node_params.h"
 #include "ros_conversions.h"
 
 namespace sbot_node {
@@ -115,6 +115,10 @@ RobotModulesRos::RobotModulesRos(ros::NodeHandle nh, ros::NodeHandle pnh, const 
   pnh_.param("camera/width", width, 640);
   pnh_.param("camera/height", height, 448);
   pnh_.param("camera/internal_scale", scale, 4);
+  if (width < 16 || height < 16 || scale < 1)
+    ROS_WARN_ONCE("simulator: ~camera/width and ~camera/height must be >= 16 px and ~camera/internal_scale >= 1, got "
+                  "%d, %d, %d: using %d, %d, %d", width, height, scale, std::max(16, width), std::max(16, height),
+                  std::max(1, scale));
   camera_params_.width = std::max(16, width);
   camera_params_.height = std::max(16, height);
   camera_params_.internal_width = std::max(8, camera_params_.width / std::max(1, scale));
@@ -518,7 +522,12 @@ void RobotModulesRos::onLeds(const sbot_msgs::LedState::ConstPtr& msg) {
 
 void RobotModulesRos::onSpeaker(const std_msgs::Float64::ConstPtr& msg) {
   if (!robot_) return;
-  if (!std::isfinite(msg->data) || msg->data <= 0) {
+  if (!std::isfinite(msg->data) || msg->data < 0) {
+    ROS_WARN_THROTTLE(1.0, "%s/speaker rejected: %f is not a frequency (Hz >= 0; 0 turns it off; the speaker keeps its state)",
+                      name_.c_str(), msg->data);
+    return;
+  }
+  if (msg->data == 0) {
     suite_->stopSpeaker();
   } else {
     suite_->setSpeaker(msg->data, 1.0);
@@ -650,36 +659,38 @@ bool RobotModulesRos::onSetSamplingRate(sbot_msgs::SetSamplingRate::Request& req
 // ---- world ----------------------------------------------------------------------------------------
 
 ModulesRosInterface::ModulesRosInterface(ros::NodeHandle nh, ros::NodeHandle pnh,
-                                         std::unique_ptr<sbot::World>& world, const std::string& scenario_path)
-    : nh_(nh), pnh_(pnh), world_(world) {
-  // The sensed environment of the scenario (scenario.cpp lets these keys through; see scenario.h).
-  try {
-    const YAML::Node root = YAML::LoadFile(scenario_path);
-    const YAML::Node w = root["world"];
-    if (w && w["lamps"]) {
-      for (const YAML::Node& l : w["lamps"]) {
-        LampSpec s;
-        const YAML::Node p = l["position"];
-        if (!p || !p.IsSequence() || p.size() != 3) throw std::runtime_error("world.lamps[].position: expected [x, y, z]");
-        s.position = sbot::Vec3(p[0].as<double>(), p[1].as<double>(), p[2].as<double>());
-        const std::string where = sbot::positionProblem(s.position);
-        if (!where.empty()) throw std::runtime_error("world.lamps[].position: " + where);
-        s.intensity = l["intensity"] ? l["intensity"].as<double>() : 0.0;
-        if (!std::isfinite(s.intensity) || s.intensity < 0) throw std::runtime_error("world.lamps[].intensity: expected >= 0 mcd");
-        if (const YAML::Node c = l["colour"]) s.colour = sbot::Vec3(c[0].as<double>(), c[1].as<double>(), c[2].as<double>());
-        lamps_.push_back(s);
-      }
-    }
-    if (w && w["ambient_light"]) ambient_ = w["ambient_light"].as<double>();
-  } catch (const std::exception& e) {
-    ROS_ERROR("simulator: %s: lamps / ambient light ignored: %s", scenario_path.c_str(), e.what());
-  }
+                                         std::unique_ptr<sbot::World>& world, const sbot::Scenario& scenario)
+    : nh_(nh), pnh_(pnh), world_(world), lamps_(scenario.lamps), ambient_(scenario.ambient_light) {
   ros::NodeHandle sim(nh_, "sim");
   set_lamp_srv_ = sim.advertiseService("set_lamp", &ModulesRosInterface::onSetLamp, this);
   set_ambient_srv_ = sim.advertiseService("set_ambient_light", &ModulesRosInterface::onSetAmbient, this);
 }
 
 ModulesRosInterface::~ModulesRosInterface() { detach(); }
+
+bool ModulesRosInterface::checkRateParams(const ros::NodeHandle& pnh) {
+  if (!pnh.hasParam("rates")) return true;
+  XmlRpc::XmlRpcValue rates;
+  pnh.getParam("rates", rates);
+  std::string known;
+  for (const auto& [ch, def] : channelDefaults()) known += (known.empty() ? "" : ", ") + ch;
+  if (rates.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
+    ROS_FATAL("simulator: ~rates must be a map of channel: Hz (channels: %s)", known.c_str());
+    return false;
+  }
+  bool ok = true;
+  for (auto it = rates.begin(); it != rates.end(); ++it) {
+    const auto& defaults = channelDefaults();
+    if (std::none_of(defaults.begin(), defaults.end(), [&](const auto& c) { return c.first == it->first; })) {
+      ROS_FATAL("simulator: ~rates/%s: unknown channel (channels: %s)", it->first.c_str(), known.c_str());
+      ok = false;
+      continue;
+    }
+    double hz = 0;
+    ok &= readTypedParam(pnh, "rates/" + it->first, hz);
+  }
+  return ok;
+}
 
 RobotModulesRos& ModulesRosInterface::modulesFor(const std::string& name) {
   auto& m = robots_[name];
@@ -691,8 +702,8 @@ void ModulesRosInterface::attach() {
   detach();
   if (!world_) return;
   env_ = std::make_unique<sn::Environment>(*world_);
-  for (const LampSpec& l : lamps_) env_->addLamp(l.position, l.intensity, l.colour);
-  env_->setAmbientLight(std::max(0.0, ambient_));
+  for (const sbot::LampSpawn& l : lamps_) env_->addLamp(l.position, l.intensity, l.colour);
+  env_->setAmbientLight(ambient_);
   bound_world_ = world_.get();
   for (sbot::Robot* r : world_->robots()) modulesFor(r->name()).bind(*world_, *env_, *r);
 }

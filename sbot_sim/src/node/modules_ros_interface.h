@@ -51,6 +51,7 @@
 #include "publication_stamps.h"
 #include "sbot_sim/core/actuators/gripper.h"
 #include "sbot_sim/core/actuators/side_arm.h"
+#include "sbot_sim/core/scenario.h"
 #include "sbot_sim/core/sensors/environment.h"
 #include "sbot_sim/core/sensors/raw_camera.h"
 #include "sbot_sim/core/sensors/sensor_suite.h"
@@ -60,12 +61,6 @@ namespace sbot_node {
 
 /// Hz of an sbot.h SAMPLING_RATE_xx code (1..8); 0 for an unknown code.
 double samplingRateHz(unsigned code);
-
-struct LampSpec {
-  sbot::Vec3 position = sbot::Vec3::Zero();
-  double intensity = 0;
-  sbot::Vec3 colour = sbot::Vec3::Ones();
-};
 
 class RobotModulesRos {
  public:
@@ -128,9 +123,14 @@ class RobotModulesRos {
 
 class ModulesRosInterface {
  public:
+  /// `scenario`'s lamps and ambient light (checked by the core's scenario parser) are the sensed
+  /// environment; /sim/set_lamp and /sim/set_ambient_light change them, and the changes outlive a reset.
   ModulesRosInterface(ros::NodeHandle nh, ros::NodeHandle pnh, std::unique_ptr<sbot::World>& world,
-                      const std::string& scenario_path);
+                      const sbot::Scenario& scenario);
   ~ModulesRosInterface();
+  /// ~rates/<channel>: every channel one of the modules' (an unknown one was ignored), a number.
+  /// Logs what is wrong as fatal and returns false.
+  static bool checkRateParams(const ros::NodeHandle& pnh);
   /// Build the Environment for the current world and bind every robot. Call after the world exists.
   void attach();
   /// Drop every module and the Environment. Call before the world is destroyed (reset, shutdown).
@@ -151,8 +151,8 @@ class ModulesRosInterface {
   ros::NodeHandle nh_, pnh_;
   std::unique_ptr<sbot::World>& world_;
   sbot::World* bound_world_ = nullptr;
-  std::vector<LampSpec> lamps_;
-  double ambient_ = 0;
+  std::vector<sbot::LampSpawn> lamps_;
+  double ambient_ = 0;  ///< [mcd/cm^2]
   std::unique_ptr<sbot::sensors::Environment> env_;
   std::map<std::string, std::unique_ptr<RobotModulesRos>> robots_;
   ros::ServiceServer set_lamp_srv_, set_ambient_srv_;

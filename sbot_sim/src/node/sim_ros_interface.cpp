@@ -1,5 +1,6 @@
 #include "sim_ros_interface.h"
 
+#include "node_params.h"
 #include "publication_stamps.h"
 #include "robot_lookup.h"
 
@@ -53,17 +54,31 @@ bool SimRosInterface::readParams() {
               "_scenario:=$(rospack find swarmbot3d)/config/scenarios/flat_swarm.yaml");
     return false;
   }
-  pnh_.param("robots", params_.robots, -1);
-  pnh_.param("level", params_.level, std::string());
-  pnh_.param("real_time_factor", params_.real_time_factor, 1.0);
-  pnh_.param("duration", params_.duration, 0.0);
-  pnh_.param("publish_rate", params_.publish_rate, 50.0);
-  pnh_.param("paused", params_.paused, false);
-  pnh_.param("set_description_params", params_.set_description_params, false);
-  pnh_.param("effects", params_.effects, std::string());
-  pnh_.param("lockstep", params_.lockstep.enabled, false);
-  pnh_.param("lockstep_controllers", params_.lockstep.controllers, 0);
-  pnh_.param("lockstep_timeout", params_.lockstep.timeout, 10.0);
+  // Defaults: SimParams (sim_ros_interface.h).
+  ok &= readTypedParam(pnh_, "robots", params_.robots);
+  ok &= readTypedParam(pnh_, "level", params_.level);
+  ok &= readTypedParam(pnh_, "real_time_factor", params_.real_time_factor);
+  ok &= readTypedParam(pnh_, "duration", params_.duration);
+  ok &= readTypedParam(pnh_, "publish_rate", params_.publish_rate);
+  ok &= readTypedParam(pnh_, "paused", params_.paused);
+  ok &= readTypedParam(pnh_, "set_description_params", params_.set_description_params);
+  ok &= readTypedParam(pnh_, "effects", params_.effects);
+  ok &= readTypedParam(pnh_, "lockstep", params_.lockstep.enabled);
+  ok &= readTypedParam(pnh_, "lockstep_controllers", params_.lockstep.controllers);
+  ok &= readTypedParam(pnh_, "lockstep_timeout", params_.lockstep.timeout);
+  {  // Read by the modules, markers and graph publishers (their ranges are checked there): types here.
+    bool flag = false;
+    int whole = 0;
+    double number = 0;
+    ok &= readTypedParam(pnh_, "modules", flag);
+    ok &= readTypedParam(pnh_, "marker_rate", number);
+    ok &= readTypedParam(pnh_, "trail_length", whole);
+    ok &= readTypedParam(pnh_, "graph_rate", number);
+    ok &= readTypedParam(pnh_, "camera/width", whole);
+    ok &= readTypedParam(pnh_, "camera/height", whole);
+    ok &= readTypedParam(pnh_, "camera/internal_scale", whole);
+    ok &= ModulesRosInterface::checkRateParams(pnh_);
+  }
   ROS_INFO("simulator: ~scenario=%s ~robots=%d ~level=%s ~real_time_factor=%g ~duration=%g ~publish_rate=%g "
            "~paused=%s ~set_description_params=%s ~effects=%s", params_.scenario.c_str(), params_.robots,
            params_.level.empty() ? "(the scenario's)" : params_.level.c_str(),
@@ -153,7 +168,7 @@ bool SimRosInterface::init() {
   bool modules = true;  // ~modules: false = no sensor/actuator modules (benchmarking the bare node)
   pnh_.param("modules", modules, true);
   if (modules) {
-    modules_ = std::make_unique<ModulesRosInterface>(nh_, pnh_, world_, params_.scenario);
+    modules_ = std::make_unique<ModulesRosInterface>(nh_, pnh_, world_, scenario_);
     modules_->attach();
   }
   if (swarm_ && modules_) {  // spawn / delete / model switch keep the modules bound
@@ -432,8 +447,8 @@ bool SimRosInterface::onSetPose(sbot_msgs::SetPose::Request& req, sbot_msgs::Set
     }
   }
   try {
-    robot->setBasePose(sbot::Pose(sbot::Vec3(req.x, req.y, req.z), sbot::quatFromRPY(0, 0, req.yaw)));
-    res.success = true;
+    res.message = world_->placeRobot(*robot, sbot::Pose(sbot::Vec3(req.x, req.y, req.z), sbot::quatFromRPY(0, 0, req.yaw)));
+    res.success = res.message.empty();
   } catch (const std::exception& e) {
     res.message = e.what();
   }

@@ -3,7 +3,9 @@
 subprocess against the rostest master; it must exit non-zero, quickly, with a message on stderr that
 names the offending file and field."""
 import os
+import shutil
 import subprocess
+import tempfile
 import unittest
 
 import rospkg
@@ -29,13 +31,13 @@ class TestMalformedScenario(unittest.TestCase):
         rospy.init_node('test_malformed_scenario')
         cls.binary = simulator_binary()
 
-    def run_node(self, *params):
+    def run_node(self, *params, env=None):
         TestMalformedScenario.counter += 1
         name = 'bad_simulator_%d' % TestMalformedScenario.counter
         cmd = [self.binary, '__name:=' + name] + list(params)
         try:
             proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=30,
-                                  universal_newlines=True)
+                                  universal_newlines=True, env=env)
         except subprocess.TimeoutExpired:
             self.fail('%s did not exit within 30 s' % ' '.join(cmd))
         return proc
@@ -87,6 +89,51 @@ class TestMalformedScenario(unittest.TestCase):
         effects = self.fixture('malformed.effects.yaml')
         self.assertRefused(self.run_node('_scenario:=' + scenario, '_effects:=' + effects), effects,
                            'effects[0].params.delay')
+
+    # An outside probe (2026-11-29) found these crashing the node (a stack overflow, an abort from
+    # inside the sensor set-up) or passing without a word.
+    def scenario_with(self, world_lines):
+        """three_robots.yaml with `world_lines` added under world:, as a temporary file."""
+        with open(self.fixture('three_robots.yaml')) as f:
+            text = f.read().replace('world:\n', 'world:\n' + world_lines, 1)
+        handle, path = tempfile.mkstemp(suffix='.yaml')
+        with os.fdopen(handle, 'w') as f:
+            f.write(text)
+        self.addCleanup(os.remove, path)
+        return path
+
+    def test_infinite_ambient_light(self):
+        path = self.scenario_with('  ambient_light: .inf\n')
+        self.assertRefused(self.run_node('_scenario:=' + path), path, 'world.ambient_light', 'must be finite')
+
+    def test_lamp_without_a_position(self):
+        path = self.scenario_with('  lamps: [{position: [0, 0, 1], intensity: 10}, {intensity: 5}]\n')
+        self.assertRefused(self.run_node('_scenario:=' + path), path, 'world.lamps[1].position')
+
+    def test_recursive_yaml(self):
+        path = self.scenario_with('  solver: &loop [*loop]\n')
+        self.assertRefused(self.run_node('_scenario:=' + path), path, 'recursive YAML is refused')
+
+    def test_parameters_of_the_wrong_type(self):
+        path = self.fixture('three_robots.yaml')
+        self.assertRefused(self.run_node('_scenario:=' + path, '_robots:=abc'), '~robots must be a whole number', "'abc'")
+        self.assertRefused(self.run_node('_scenario:=' + path, '_paused:=maybe'), '~paused must be true or false')
+        self.assertRefused(self.run_node('_scenario:=' + path, '_rates/nosuch:=5'), '~rates/nosuch: unknown channel')
+
+    def test_sidecar_value_the_sensors_cannot_use(self):
+        description = rospkg.RosPack().get_path('sbot_description')
+        copy = tempfile.mkdtemp()
+        self.addCleanup(shutil.rmtree, copy)
+        for sub in ('urdf', 'config'):
+            shutil.copytree(os.path.join(description, sub), os.path.join(copy, sub))
+        sidecar = os.path.join(copy, 'urdf', 'simple.sbot.yaml')
+        with open(sidecar) as f:
+            text = f.read()
+        with open(sidecar, 'w') as f:
+            f.write(text.replace('ir_model: lut', 'ir_model: psychic', 1))
+        env = dict(os.environ, SBOT_DESCRIPTION_DIR=copy)
+        proc = self.run_node('_scenario:=' + self.fixture('three_robots.yaml'), env=env)
+        self.assertRefused(proc, sidecar, 'extra.ir_model', "'psychic'")
 
     def test_good_scenario_is_accepted(self):
         # Control: the same invocation with a valid scenario runs until its duration and exits 0.

@@ -67,6 +67,23 @@ class TestSimServices(unittest.TestCase):
         self.assertAlmostEqual(p.position.y, -0.4, delta=0.005)
         self.assertAlmostEqual(wrap(yaw_of(p.orientation) - 0.3), 0.0, delta=0.02)
 
+    def test_set_pose_into_the_ground_or_a_robot_fails_and_leaves_it(self):
+        # Accepted until 2026-11-29: a robot 5 m under the floor then rose through it at 0.5 m/s.
+        t = self.sim.step_ok(self, 5)
+        before = self.odom.wait_stamp(t).pose.pose.position
+        res = self.sim.set_pose('sbot_2', 0.3, 0.3, -5.0, 0.0)
+        self.assertFalse(res.success)
+        self.assertIn("robot 'sbot_2' there would sit", res.message)
+        self.assertIn('inside the ground', res.message)
+        res = self.sim.set_pose('sbot_2', 0.0, 0.0, before.z, 0.0)  # onto sbot_0
+        self.assertFalse(res.success)
+        self.assertIn("inside robot 'sbot_0'", res.message)
+        t = self.sim.step_ok(self, 5)
+        after = self.odom.wait_stamp(t).pose.pose.position
+        self.assertAlmostEqual(after.x, before.x, delta=0.002)
+        self.assertAlmostEqual(after.y, before.y, delta=0.002)
+        self.assertAlive()
+
     def test_step_only_while_paused(self):
         t0 = self.sim.step_ok(self, 1)
         t1 = self.sim.step_ok(self, 10)
