@@ -10,6 +10,7 @@
 #include <iomanip>
 #include <regex>
 #include <sstream>
+#include <tuple>
 #include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
@@ -39,7 +40,13 @@ std::string location(const std::string& file, int line, int column, const std::s
   throw DatasetError(file, line, col, "", (field.empty() ? "" : "field '" + field + "': ") + what);
 }
 
+bool isDirectory(const std::string& p);
+
 std::string readFile(const std::string& path, const std::string& referrer, const YAML::Node& where) {
+  if (isDirectory(path)) {  // it opens as a stream that reads nothing: "empty file"
+    if (referrer.empty()) throw DatasetError(path, 0, 0, "", "is a folder, not a file");
+    fail(referrer, where, "", "'" + path + "' is a folder, not a file");
+  }
   std::ifstream in(path);
   if (!in) {
     if (referrer.empty()) throw DatasetError(path, 0, 0, "", "cannot open file");
@@ -434,6 +441,11 @@ void parseRunCsv(const std::string& text, const std::string& file, Run& run) {
       double fx = 0, fy = 0, pv = 0;
       const bool hfx = col.count("force_x") && value("force_x", fx);
       const bool hfy = col.count("force_y") && value("force_y", fy);
+      for (auto [c, v, has] : {std::tuple<const char*, double, bool>{"force_x", fx, hfx}, {"force_y", fy, hfy}})
+        if (has && std::abs(v) > kMaxPullForce)
+          throw DatasetError(file, line_no, col.at(c) + 1, c,
+                             "value " + fmtNumber(v) + " N outside [-" + fmtNumber(kMaxPullForce) + ", " +
+                                 fmtNumber(kMaxPullForce) + "] N (an s-bot weighs 6.6 N: is it in newtons?)");
       if (hfx || hfy) {
         auto prev = run.forceAt(t);
         run.force_t.push_back(t);

@@ -20,6 +20,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// Limits that catch times written in the wrong unit (ms, epoch stamps) before a replay simulates them.
 constexpr double kMaxRunDuration = 3600.0;  ///< [s] last time stamp of a drive run
 constexpr double kMaxRowGap = 60.0;         ///< [s] between two consecutive rows of a drive run
+constexpr double kMaxPullForce = 100.0;     ///< [N] force_x / force_y (an s-bot weighs 6.6 N; the seed pulled with 1.2 N)
 /// [s] shortest re-anchoring segment (align_segment): shorter ones follow the measurement so closely
 /// that they hide the model's error (0.05 s hid a 10 % speed error entirely).
 constexpr double kMinAlignSegment = 1.0;

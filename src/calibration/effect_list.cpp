@@ -38,6 +38,13 @@ std::vector<EffectConfig> parseEffectList(const std::string& spec, const std::st
       c.name = e.substr(0, colon);
       requireEffect(c.name, source);
       const EffectInfo& info = EffectRegistry::instance().info(c.name);
+      if (!info.params.empty() && (colon == std::string::npos || colon + 1 == e.size())) {
+        // Its defaults would be taken silently: for most effects the nominal model, nothing hidden.
+        std::string params;
+        for (const auto& p : info.params) params += (params.empty() ? "" : ", ") + p.name;
+        throw std::invalid_argument(source + " '" + e + "': give the values (e.g. " + c.name + ":" +
+                                    info.params.front().name + "=...; parameters: " + params + ")");
+      }
       if (colon != std::string::npos) {
         for (const auto& kv : splitList(e.substr(colon + 1), ',')) {
           const auto eq = kv.find('=');

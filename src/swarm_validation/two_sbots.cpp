@@ -74,6 +74,10 @@ int main(int argc, char** argv) {
       return a == "--help" ? 0 : 2;
     }
   }
+  if (setup.seed_friction && setup.track_mu > 0) {
+    std::fprintf(stderr, "two_sbots: --seed-friction and --track-mu choose the friction law two ways; give one\n");
+    return 2;
+  }
   sbot_tools::requireLevel("two_sbots", "--level " + level + " (or $SBOT_DESCRIPTION_DIR)", level);  // the default too
   const std::string friction = setup.seed_friction ? "seed (force limit 1.2 N per contact)"
                                : "Coulomb (treels mu " + std::to_string(setup.track_mu > 0 ? setup.track_mu : sbot::validation::kPolystyreneTrackMu).substr(0, 4) + ")";

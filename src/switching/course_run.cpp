@@ -15,6 +15,7 @@
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/swarm/level_policy.h"
 #include "sbot_sim/core/world.h"
+#include "sbot_sim/core/yaml_checks.h"
 
 namespace switching {
 
@@ -29,12 +30,47 @@ double cpuSeconds() {
 }
 
 Route loadRoute(const std::string& path) {
+  const auto refuse = [&](const std::string& field, const std::string& what) {
+    throw std::runtime_error(path + (field.empty() ? "" : ": field '" + field + "'") + ": " + what);
+  };
+  YAML::Node n;
+  try {
+    n = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    refuse("", "cannot open route file");
+  } catch (const YAML::Exception& e) {
+    refuse("", "not valid YAML (line " + std::to_string(e.mark.line + 1) + "): " + e.msg);
+  }
+  if (const std::string problem = sbot::yamlStructureProblem(n); !problem.empty()) refuse("", problem);
+  if (!n.IsMap()) refuse("", "expected a mapping with waypoints, goal_radius, time_limit");
+  for (const auto& kv : n) {
+    const std::string key = kv.first.as<std::string>();
+    if (key != "waypoints" && key != "goal_radius" && key != "time_limit")
+      refuse(key, "unknown field (expected waypoints, goal_radius, time_limit)");
+  }
+  const auto number = [&](const YAML::Node& v, const std::string& field) {
+    double x = 0;
+    try {
+      x = v.as<double>();
+    } catch (const YAML::Exception&) {
+      refuse(field, "expected a number");
+    }
+    if (!std::isfinite(x)) refuse(field, "must be finite");
+    return x;
+  };
   Route r;
-  YAML::Node n = YAML::LoadFile(path);
-  for (const auto& w : n["waypoints"]) r.waypoints.emplace_back(w[0].as<double>(), w[1].as<double>(), 0);
-  r.goal_radius = n["goal_radius"].as<double>(r.goal_radius);
-  r.time_limit = n["time_limit"].as<double>(r.time_limit);
-  if (r.waypoints.size() < 2) throw std::runtime_error(path + ": needs at least two waypoints");
+  const YAML::Node w = n["waypoints"];
+  if (!w || !w.IsSequence()) refuse("waypoints", "expected a list of [x, y] in m");
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    const std::string field = "waypoints[" + std::to_string(i) + "]";
+    if (!w[i].IsSequence() || w[i].size() != 2) refuse(field, "expected [x, y] in m");
+    r.waypoints.emplace_back(number(w[i][0], field), number(w[i][1], field), 0);
+  }
+  if (r.waypoints.size() < 2) refuse("waypoints", "needs at least two waypoints");
+  if (n["goal_radius"]) r.goal_radius = number(n["goal_radius"], "goal_radius");
+  if (n["time_limit"]) r.time_limit = number(n["time_limit"], "time_limit");
+  if (!(r.goal_radius > 0)) refuse("goal_radius", "must be > 0 m");
+  if (!(r.time_limit > 0) || r.time_limit > 3600) refuse("time_limit", "must be in (0, 3600] s");
   return r;
 }
 

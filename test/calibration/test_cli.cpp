@@ -262,6 +262,8 @@ TEST(Cli, GenerateRefusesAFolderInUseAndValuesItCannotMake) {
     refused(std::string("--families straight --duration ") + d, "--duration expects 2 to 3600 s");
   refused("--duration nan", "--duration expects a finite number, got 'nan'");
   refused("--hide speed_scale:scale=", "--hide 'speed_scale:scale=': speed_scale.scale expects a finite number, got ''");
+  // Without values the effect's defaults were hidden: for latency, no delay at all.
+  refused("--hide latency", "--hide 'latency': give the values (e.g. latency:delay=...; parameters: delay)");
   refused("--seed -5", "--seed expects a whole number from 0 to 9223372036854775807, got '-5'");
   refused("--seed 99999999999999999999", "--seed expects a whole number from 0 to 9223372036854775807");
   refused("--tilt 95", "--tilt expects a floor tilt from 0 to 30 deg");

@@ -231,6 +231,8 @@ TEST(Dataset, ValuesNoReplayCanUseAreRefusedByPlace) {
       {"ir_range", head + "0.1,,,0,99999\n", 3, "ir0", "outside the range of ir0 [0, 8191]"},
       {"position_range", head + "0.1,,,1e300,\n", 3, "x", "outside the range of x"},
       {"no_sample", "t,cmd_left,cmd_right,x\n0,1,1,\n1,2,2,\n", 1, "", "no measured value in any row"},
+      // a pull of 1e12 N was replayed (nRMS 3.7e7)
+      {"force", "t,cmd_left,cmd_right,x,force_x\n0,1,1,0,1e12\n", 2, "force_x", "outside [-100, 100] N"},
   };
   for (const Case& c : cases) {
     const DatasetError e = errorOf(makeDataset(c.name, c.csv));
@@ -238,6 +240,11 @@ TEST(Dataset, ValuesNoReplayCanUseAreRefusedByPlace) {
     EXPECT_EQ(e.columnName(), c.column) << c.name << ": " << e.what();
     EXPECT_NE(std::string(e.what()).find(c.says), std::string::npos) << c.name << ": " << e.what();
   }
+  // A run file that is a folder read as an empty stream ("empty file").
+  std::string yaml = kYaml;
+  yaml.replace(yaml.find("straight.csv"), 12, ".");
+  const DatasetError folder = errorOf(makeDataset("folder", "t,cmd_left,cmd_right,x\n0,1,1,0\n", yaml));
+  EXPECT_NE(std::string(folder.what()).find("is a folder, not a file"), std::string::npos) << folder.what();
   // A byte-order mark (spreadsheet export) is not part of the first column's name.
   EXPECT_NO_THROW(loadDataset(makeDataset("bom", "\xEF\xBB\xBFt,cmd_left,cmd_right,x\n0,1,1,0\n")));
 }

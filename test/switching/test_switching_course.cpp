@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
 
 #include "course_run.h"
 #include "sbot_sim/core/robot_description.h"
@@ -31,6 +34,43 @@ TEST(SwitchingCourse, SwitchedRunMatchesDetailedRun) {
   EXPECT_GT(s.level_time.at("detailed"), 0.0);
   EXPECT_LT(s.level_time.at("detailed"), 0.2 * s.sim);
   EXPECT_LT(s.cpu, d.cpu);  // loose: CPU time of one run on a shared machine
+}
+
+// A route file is checked like every other input: it was read with bare yaml-cpp calls ("bad file",
+// "bad conversion", NaN waypoints taken).
+TEST(SwitchingCourse, ARouteFileIsCheckedByField) {
+  const std::string path = "/tmp/sbot_route_test.route.yaml";
+  const auto errorOf = [&](const std::string& text) {
+    std::ofstream(path) << text;
+    try {
+      switching::loadRoute(path);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::pair<std::string, std::string> cases[] = {
+      {"waypoints: [[0, 0], [1, .nan]]", "field 'waypoints[1]': must be finite"},
+      {"waypoints: [[0, 0], [1]]", "field 'waypoints[1]': expected [x, y] in m"},
+      {"waypoints: [[0, 0]]", "needs at least two waypoints"},
+      {"waypoints: [[0, 0], [1, 0]]\ngoal_radius: -1", "field 'goal_radius': must be > 0 m"},
+      {"waypoints: [[0, 0], [1, 0]]\ntime_limt: 5", "field 'time_limt': unknown field"},
+      {"waypoints: [[0, 0], [1, x]]", "field 'waypoints[1]': expected a number"},
+      {"waypoints: &w [*w]", "recursive YAML is refused"},
+  };
+  for (const auto& [text, says] : cases) {
+    const std::string e = errorOf(text);
+    EXPECT_NE(e.find(path), std::string::npos) << text << ": " << e;
+    EXPECT_NE(e.find(says), std::string::npos) << text << ": " << e;
+  }
+  EXPECT_EQ(errorOf("waypoints: [[0, 0], [1, 0]]\ngoal_radius: 0.1"), "");
+  std::remove(path.c_str());
+  try {
+    switching::loadRoute("/nonexistent.route.yaml");
+    ADD_FAILURE() << "a missing route file was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot open route file"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

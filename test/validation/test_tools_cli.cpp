@@ -50,6 +50,7 @@ TEST(ToolsCli, NonNumbersAndOutOfRangeValuesAreRefusedByName) {
   expectRefused("two_sbots", "--angles 10,x", "--angles expects a number in [0, 90], found 'x'");
   expectRefused("two_sbots", "--trials 2.5", "--trials expects a whole number, found '2.5'");
   expectRefused("two_sbots", "--track-mu -1", "--track-mu expects a number");
+  expectRefused("two_sbots", "--seed-friction --track-mu 1", "--seed-friction and --track-mu choose the friction law two ways");
   expectRefused("two_sbots", "--level huge", "two_sbots: --level huge (or $SBOT_DESCRIPTION_DIR): unknown model level 'huge'");  // aborted
   expectRefused("sbot_validate", "--trial step huge 0.01", "sbot_validate: --trial step huge: unknown model level 'huge'");  // aborted
 }
@@ -66,6 +67,9 @@ TEST(ToolsCli, BenchRefusesWhatItCannotRun) {
   refused("--chains x", "sbot_bench: --chains expects a number");
   refused("--level huge", "sbot_bench: --level: unknown model level 'huge'");
   refused("--seconds", "sbot_bench: --seconds needs a value");
+  // A step of 1e-9 s sized per-robot buffers past the machine's memory; 0x10 read as 16.
+  refused("--step 1e-9", "sbot_bench: --step expects a number in [0.0001, 0.5], found '1e-9'");
+  refused("--seconds 0x10", "sbot_bench: --seconds expects a number in [0.001, 1e+06], found '0x10'");
 }
 
 // The last option without its value (two_sbots used to read it as "": --level "" then failed later
