@@ -532,13 +532,25 @@ void overlapCallback(void* data, dGeomID o1, dGeomID o2) {
 
 }  // namespace
 
-World::Overlap World::deepestOverlap(const Robot& robot) const {
+World::Overlap World::deepestOverlap(const Robot& robot, bool robots_only) const {
   Overlap deepest;
   OverlapQuery q{&robot, &deepest};
   const dGeomID own = reinterpret_cast<dGeomID>(robot.space());
-  dSpaceCollide2(own, reinterpret_cast<dGeomID>(static_space_), &q, &overlapCallback);
+  if (!robots_only) dSpaceCollide2(own, reinterpret_cast<dGeomID>(static_space_), &q, &overlapCallback);
   dSpaceCollide2(own, reinterpret_cast<dGeomID>(space_), &q, &overlapCallback);
   return deepest;
+}
+
+std::string World::robotsOverlapProblem() const {
+  for (const auto& r : robots_) {
+    const Overlap o = deepestOverlap(*r, true);
+    if (o.depth <= kPlacementTolerance) continue;
+    std::ostringstream why;
+    why << "robot '" << r->name() << "' and " << o.with << " overlap by " << std::fixed << std::setprecision(3)
+        << o.depth << " m at their start poses (at most " << kPlacementTolerance << " m; a robot is 0.116 m across)";
+    return why.str();
+  }
+  return "";
 }
 
 std::string World::placeRobot(Robot& robot, const Pose& pose) {

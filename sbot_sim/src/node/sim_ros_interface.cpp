@@ -201,6 +201,8 @@ std::unique_ptr<sbot::World> SimRosInterface::buildWorld() const {
   auto world = std::make_unique<sbot::World>(scenario_.world);
   for (const sbot::RobotSpawn& s : scenario_.robots)
     world->addRobot(sbot::loadLevel(s.level), s.pose, s.name);
+  if (const std::string overlap = world->robotsOverlapProblem(); !overlap.empty())
+    throw sbot::ConfigError(params_.scenario, "robots", overlap);
   sbot::swarm::addScenarioLinks(*world, scenario_.links);  // static links (seed 2.2.3)
   if (!scenario_.effects_file.empty()) {
     // The calibration workbench's effects file: throws ConfigError naming file and field.

@@ -102,6 +102,14 @@ class TestMalformedScenario(unittest.TestCase):
         self.addCleanup(os.remove, path)
         return path
 
+    def test_robots_spawned_inside_each_other(self):
+        path = self.scenario_with('')
+        with open(path) as f:
+            text = f.read().replace('pose: {x: 0.0, y: 0.8,', 'pose: {x: 0.05, y: 0.0,')
+        with open(path, 'w') as f:
+            f.write(text)
+        self.assertRefused(self.run_node('_scenario:=' + path), path, "'robots'", "robot 'sbot_0' and robot 'sbot_1' overlap")
+
     def test_infinite_ambient_light(self):
         path = self.scenario_with('  ambient_light: .inf\n')
         self.assertRefused(self.run_node('_scenario:=' + path), path, 'world.ambient_light', 'must be finite')

@@ -101,7 +101,11 @@ class World {
     double depth = 0;  ///< [m] ODE's penetration depth; 0 when nothing overlaps
     std::string with;  ///< "the ground", "box 'step'" or "robot 'sbot_3'"
   };
-  Overlap deepestOverlap(const Robot& robot) const;
+  /// `robots_only`: other robots alone, not the terrain.
+  Overlap deepestOverlap(const Robot& robot, bool robots_only = false) const;
+  /// Why the robots as they stand overlap each other by more than kPlacementTolerance, naming the
+  /// first such pair and the depth ("" if none): spawned so, the contacts throw them apart.
+  std::string robotsOverlapProblem() const;
   /// Teleport `robot` (Robot::setBasePose: base_link at `pose`, at rest) unless it would then sit
   /// deeper than kPlacementTolerance inside the terrain or another robot, which the contacts would
   /// resolve by throwing it out (a robot set 5 m under the floor rose through it at 0.5 m/s). Returns
