@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 #include <sbot_msgs/SwarmGraph.h>
@@ -212,6 +213,15 @@ bool SwarmRosInterface::onSpawn(sbot_msgs::Spawn::Request& req, sbot_msgs::Spawn
       return true;
     }
     robot = &world_->addRobot(level, sbot::Pose2D{req.x, req.y, req.yaw}, req.name);
+    // Spawned inside another robot, the contacts would throw the two apart.
+    if (const sbot::World::Overlap o = world_->deepestOverlap(*robot, true); o.depth > sbot::World::kPlacementTolerance) {
+      world_->removeRobot(req.name);
+      std::ostringstream why;
+      why << "'" << req.name << "' there would overlap " << o.with << " by " << std::fixed << std::setprecision(3)
+          << o.depth << " m (at most " << sbot::World::kPlacementTolerance << " m): not spawned";
+      res.message = why.str();
+      return true;
+    }
   } catch (const std::exception& e) {
     res.message = e.what();
     return true;

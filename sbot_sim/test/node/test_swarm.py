@@ -109,6 +109,9 @@ class TestSwarm(unittest.TestCase):
             res = self.spawn(name, 'simple', 1.0, 1.0, 0.0)
             self.assertFalse(res.success, name)
             self.assertIn("invalid robot name '%s'" % name, res.message)
+        res = self.spawn('sbot_9', 'simple', -0.8, -0.78, 0.0)  # onto sbot_2
+        self.assertFalse(res.success)
+        self.assertIn("'sbot_9' there would overlap robot 'sbot_2'", res.message)
         res = self.delete('sbot_42')
         self.assertFalse(res.success)
         self.assertIn("unknown robot 'sbot_42'", res.message)
