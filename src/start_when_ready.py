@@ -102,4 +102,8 @@ def main():
 
 
 if __name__ == '__main__':
-    main()
+    try:
+        main()
+    except rospy.ROSInterruptException:
+        # The launch is shutting down (e.g. the simulator refused its scenario and said why): no traceback.
+        pass

@@ -14,13 +14,17 @@ import unittest
 import rospy
 import rostest
 from nav_msgs.msg import Odometry
-from sbot_msgs.msg import ModelLevel, TrackSpeed
+from geometry_msgs.msg import Point
+from sbot_msgs.msg import ModelLevel, SwarmGraph, TrackSpeed
 from sbot_msgs.srv import SetModelLevel
 
 
 class TestSwarmManager(unittest.TestCase):
-    def test_switches_at_the_gap_and_back(self):
+    @classmethod
+    def setUpClass(cls):
         rospy.init_node('test_swarm_manager')
+
+    def test_switches_at_the_gap_and_back(self):
         levels = []  # (x at the switch, level)
         x = [0.0]
         pose = [(0.0, 0.0, 0.0)]
@@ -77,6 +81,20 @@ class TestSwarmManager(unittest.TestCase):
         with lock:
             self.assertEqual(levels[-1][1], 'detailed')
         self.assertFalse(override('sbot_0', 'nonsense').success)
+
+    def test_z_a_malformed_graph_is_ignored(self):
+        # Its connection matrix was read past its end: the manager died with a segmentation fault.
+        rospy.wait_for_service('/swarm_manager/set_override', timeout=30.0)
+        pub = rospy.Publisher('/swarm/graph', SwarmGraph, queue_size=1, latch=True)
+        bad = SwarmGraph(n=3, names=['a', 'b', 'c'], positions=[Point(0, 0, 0), Point(1, 0, 0), Point(2, 0, 0)],
+                         headings=[0.0, 0.0, 0.0], connections=[])
+        bad.header.stamp = rospy.Time(1e6)
+        for _ in range(5):
+            pub.publish(bad)
+            time.sleep(0.2)
+        override = rospy.ServiceProxy('/swarm_manager/set_override', SetModelLevel)
+        res = override('sbot_0', '')  # the manager still answers
+        self.assertTrue(res.success, res.message)
 
 
 if __name__ == '__main__':

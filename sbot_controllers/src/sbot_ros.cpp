@@ -72,6 +72,9 @@
 
 namespace {
 
+/// An API argument into a service's int16 field, clamped (a bare cast wraps 40000 to -25536).
+int16_t toInt16(int v) { return static_cast<int16_t>(v < -32768 ? -32768 : v > 32767 ? 32767 : v); }
+
 using Clock = std::chrono::steady_clock;
 
 void (*g_error)(const char*) = nullptr;
@@ -358,9 +361,14 @@ bool call(const char* service, Srv& srv, const char* fn) {
 }
 
 void setRate(const char* channel, SamplingRate rate, const char* fn) {
+  // Named with the caller's value: the uint8 field made 999 read "code 255" in the reply.
+  if (static_cast<unsigned>(rate) > 255) {
+    report(false, "%s(%u): not a SAMPLING_RATE code", fn, static_cast<unsigned>(rate));
+    return;
+  }
   sbot_msgs::SetSamplingRate srv;
   srv.request.channel = channel;
-  srv.request.rate = static_cast<uint8_t>(rate > 255 ? 255 : rate);
+  srv.request.rate = static_cast<uint8_t>(rate);
   call("set_sampling_rate", srv, fn);
 }
 
@@ -409,7 +417,11 @@ void leds(const std::vector<unsigned>& groups, const unsigned* r, const unsigned
   sbot_msgs::SetLeds srv;
   for (std::size_t i = 0; i < groups.size(); ++i) {
     const std::size_t k = same ? 0 : i;
-    srv.request.group.push_back(static_cast<uint8_t>(groups[i] > 255 ? 255 : groups[i]));
+    if (groups[i] > 7) {  // named with the caller's value (the uint8 field made 300 read "group 255")
+      report(false, "%s: light group %u outside [0, 7]", fn, groups[i]);
+      return;
+    }
+    srv.request.group.push_back(static_cast<uint8_t>(groups[i]));
     srv.request.r.push_back(static_cast<uint8_t>(r[k] > 255 ? 255 : r[k]));
     srv.request.g.push_back(static_cast<uint8_t>(gr[k] > 255 ? 255 : gr[k]));
     srv.request.b.push_back(static_cast<uint8_t>(b[k] > 255 ? 255 : b[k]));
@@ -517,7 +529,7 @@ void getTrackTorque(int* left, int* right) {
 
 void setTurretRotation(int pos) {
   sbot_msgs::SetTurret srv;
-  srv.request.position = static_cast<int16_t>(pos < -32768 ? -32768 : pos > 32767 ? 32767 : pos);
+  srv.request.position = toInt16(pos);
   call("set_turret", srv, "setTurretRotation");
 }
 
@@ -537,7 +549,7 @@ void setGripperElevation(int elevation) {
   if (!ready("setGripperElevation")) return;
   std::lock_guard<std::mutex> l(g->cmd_m);
   knowGripper();
-  g->gripper_elevation = elevation < -32768 ? -32768 : elevation > 32767 ? 32767 : elevation;
+  g->gripper_elevation = toInt16(elevation);
   gripperCommand("setGripperElevation");
 }
 
@@ -551,7 +563,7 @@ void setGripperAperture(int aperture) {
   if (!ready("setGripperAperture")) return;
   std::lock_guard<std::mutex> l(g->cmd_m);
   knowGripper();
-  g->gripper_aperture = aperture < -32768 ? -32768 : aperture > 32767 ? 32767 : aperture;
+  g->gripper_aperture = toInt16(aperture);
   gripperCommand("setGripperAperture");
 }
 
@@ -579,9 +591,9 @@ void setSideArmPos(int elevation, int rotation, int depth) {
   if (!ready("setSideArmPos")) return;
   std::lock_guard<std::mutex> l(g->cmd_m);
   g->arm_known = true;
-  g->arm_e = elevation;
-  g->arm_r = rotation;
-  g->arm_d = depth;
+  g->arm_e = toInt16(elevation);  // the service's int16 (40000 became -25536: the opposite limit)
+  g->arm_r = toInt16(rotation);
+  g->arm_d = toInt16(depth);
   armCommand(sbot_msgs::SetSideArm::Request::JAWS_KEEP, "setSideArmPos");
 }
 

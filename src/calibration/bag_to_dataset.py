@@ -60,14 +60,26 @@ def tracker_pose(msg):
     return p.position.x, p.position.y, quat_yaw(p.orientation)
 
 
+# The message type each topic must have (the tracker: any type tracker_pose reads).
+TOPIC_TYPES = {"commands": "sbot_msgs/TrackSpeed", "tracks": "sbot_msgs/TrackState", "slope": "sbot_msgs/Slope",
+               "proximity": "sbot_msgs/ProximityArray", "ground": "sbot_msgs/GroundArray",
+               "light": "sbot_msgs/LightArray"}
+
+
 def read_run(bag_path, topics):
     """Rows {t: {column: value}} of one bag, t from the run's earliest stamp."""
     stamped = {}  # absolute stamp -> {column: value}
     first_pose = None  # (stamp, pose) of the earliest tracker message
     wanted = [t for t in topics.values() if t]
     with rosbag.Bag(bag_path) as bag:
-        present = set(bag.get_type_and_topic_info().topics.keys())
+        info = bag.get_type_and_topic_info().topics
+        present = set(info.keys())
         missing = [k for k, t in topics.items() if t and t not in present]
+        for key, expected in TOPIC_TYPES.items():
+            topic = topics.get(key)
+            if topic in info and info[topic].msg_type != expected:
+                raise SystemExit("%s: topic %s has type %s, expected %s (or name another with --%s-topic)"
+                                 % (bag_path, topic, info[topic].msg_type, expected, key))
         for topic, msg, bt in bag.read_messages(topics=wanted):
             t = stamp_of(msg, bt)
             row = stamped.setdefault(t, {})
@@ -77,6 +89,9 @@ def read_run(bag_path, topics):
                 pose = tracker_pose(msg)
                 if pose is None:
                     raise SystemExit("%s: tracker topic %s has unsupported type %s" % (bag_path, topic, msg._type))
+                if not all(math.isfinite(v) for v in pose):
+                    raise SystemExit("%s: tracker topic %s: message at t = %.6f s has a pose that is not finite (%s)"
+                                     % (bag_path, topic, t, ", ".join("%g" % v for v in pose)))
                 row["x"], row["y"], row["yaw"] = pose
                 if first_pose is None or t < first_pose[0]:
                     first_pose = (t, pose)
@@ -127,13 +142,15 @@ ORDER = ["cmd_left", "cmd_right", "x", "y", "yaw", "speed_left", "speed_right", 
         ["light%d" % k for k in range(8)]
 
 
-def write_csv(path, rows):
+def write_csv(path, rows, final):
+    """The run's CSV at `path` (to become `final`, which messages name); returns its columns.
+    SystemExit when the rows hold no drive run."""
     cols = [c for c in ORDER if any(c in r for r in rows.values())]
     if "cmd_left" not in cols:
-        raise SystemExit("%s: no command messages: a drive run needs the command topic" % path)
+        raise SystemExit("%s: no command messages: a drive run needs the command topic" % final)
     measured = [c for c in cols if c not in ("cmd_left", "cmd_right")]
     if not measured:
-        raise SystemExit("%s: nothing measured (no tracker, track state or sensor topic in the bag)" % path)
+        raise SystemExit("%s: nothing measured (no tracker, track state or sensor topic in the bag)" % final)
     with open(path, "w") as f:
         f.write("t," + ",".join(cols) + "\n")
         for t in sorted(rows):
@@ -220,11 +237,31 @@ def read_existing(yaml_path):
         raise SystemExit("bag_to_dataset: --append: cannot read %s: %s" % (yaml_path, error))
     if not isinstance(ds, dict) or not isinstance(ds.get("runs"), list):
         raise SystemExit("bag_to_dataset: --append: %s is not a dataset (a mapping with a 'runs' list)" % yaml_path)
+    for k, run in enumerate(ds["runs"]):
+        if not isinstance(run, dict) or not isinstance(run.get("name"), str):
+            raise SystemExit("bag_to_dataset: --append: %s: runs[%d] is not a run (a mapping with a name, file, kind "
+                             "and initial_pose)" % (yaml_path, k))
     return ds
 
 
 def write_dataset(a, ds, imported, yaml_path):
-    """The runs' CSVs and dataset.yaml (appending to `ds`); OSError when a file cannot be written."""
+    """The runs' CSVs and dataset.yaml (appending to `ds`); OSError when a file cannot be written.
+    Every file is written under a temporary name and renamed only when all of them are complete:
+    a full disk or a refused run leaves the dataset as it was (an append that failed half-way used
+    to leave a truncated dataset.yaml, losing the index of the runs already there)."""
+    pending = []  # (temporary, final) paths
+    try:
+        write_dataset_files(a, ds, imported, yaml_path, pending)
+        for temporary, final in pending:
+            os.replace(temporary, final)
+    finally:
+        for temporary, _ in pending:
+            if os.path.exists(temporary):
+                os.remove(temporary)
+    sys.stdout.write("wrote %s (%d runs)\n" % (yaml_path, len(ds["runs"])))
+
+
+def write_dataset_files(a, ds, imported, yaml_path, pending):
     names = {r["name"] for r in ds["runs"]}
     for bag, rows, pose, missing in imported:
         name = a.run_name or os.path.splitext(os.path.basename(bag))[0]
@@ -232,7 +269,9 @@ def write_dataset(a, ds, imported, yaml_path):
         while name in names:
             name = "%s_%d" % (base, k)
             k += 1
-        cols = write_csv(os.path.join(a.out, name + ".csv"), rows)
+        final = os.path.join(a.out, name + ".csv")
+        pending.append((final + ".part", final))
+        cols = write_csv(final + ".part", rows, final)
         run = {"name": name, "file": name + ".csv", "kind": "drive",
                "initial_pose": {"x": pose[0], "y": pose[1], "yaw": pose[2]} if pose else {"x": 0.0, "y": 0.0, "yaw": 0.0}}
         ds["runs"].append(run)
@@ -242,10 +281,10 @@ def write_dataset(a, ds, imported, yaml_path):
             ("; topics not in the bag: " + ", ".join(missing)) if missing else ""))
         if pose is None:
             sys.stdout.write("  warning: no tracker pose: initial_pose set to 0, 0, 0\n")
-    with open(yaml_path, "w") as f:
+    pending.append((yaml_path + ".part", yaml_path))
+    with open(yaml_path + ".part", "w") as f:
         f.write("# sbot-dataset/1 (see docs/calibration.md)\n")
         yaml.safe_dump(ds, f, default_flow_style=None, sort_keys=False)
-    sys.stdout.write("wrote %s (%d runs)\n" % (yaml_path, len(ds["runs"])))
 
 
 if __name__ == "__main__":

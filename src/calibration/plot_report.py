@@ -60,11 +60,31 @@ def read_trace(path):
     return data if data.size > 1 else None
 
 
+def read_summary(out):
+    """REPORT_DIR/summary.json as written by `sbot_calibrate compare`; SystemExit naming what is wrong
+    (it was a bare traceback for a missing folder, an empty file or a summary without variants)."""
+    path = os.path.join(out, "summary.json")
+    try:
+        with open(path) as f:
+            summary = json.load(f)
+    except OSError as error:
+        raise SystemExit("plot_report.py: cannot read %s: %s" % (path, error.strerror))
+    except ValueError as error:
+        raise SystemExit("plot_report.py: %s: not valid JSON: %s" % (path, error))
+    if not isinstance(summary, dict) or not isinstance(summary.get("runs"), list) or \
+            not isinstance(summary.get("variants"), list) or not summary["variants"]:
+        raise SystemExit("plot_report.py: %s: expected the summary of `sbot_calibrate compare` (a 'runs' list and a "
+                         "non-empty 'variants' list)" % path)
+    return summary
+
+
 def main(out):
-    with open(os.path.join(out, "summary.json")) as f:
-        summary = json.load(f)
+    summary = read_summary(out)
     plots = os.path.join(out, "plots")
-    os.makedirs(plots, exist_ok=True)
+    try:
+        os.makedirs(plots, exist_ok=True)
+    except OSError as error:
+        raise SystemExit("plot_report.py: cannot create %s: %s" % (plots, error.strerror))
     runs = summary["runs"]
     variants = summary["variants"]
     window = float(summary.get("window", 2.0))

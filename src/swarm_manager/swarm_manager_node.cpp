@@ -29,6 +29,7 @@
 #include "sbot_sim/core/scenario.h"
 #include "sbot_sim/core/swarm/level_policy.h"
 #include "sbot_sim/core/world.h"
+#include "sbot_sim/ros/typed_param.h"
 
 namespace {
 
@@ -42,7 +43,8 @@ class SwarmManager {
       return false;
     }
     try {
-      const sbot::Scenario s = sbot::loadScenario(scenario, 0);
+      // Its terrain only; read whole, as the simulator does (robots and their links checked too).
+      const sbot::Scenario s = sbot::loadScenario(scenario);
       terrain_ = std::make_unique<sbot::World>(s.world);
     } catch (const std::exception& e) {
       ROS_FATAL("swarm_manager: %s", e.what());
@@ -51,7 +53,14 @@ class SwarmManager {
     height_ = std::make_unique<sbot::swarm::HeightCache>(
         [this](double x, double y) { return terrain_->terrainHeight(x, y); });
     sbot::swarm::LevelPolicyConfig c;
-    auto param = [&](const char* name, double& v) { pnh.param(name, v, v); };
+    bool ok = true;
+    auto param = [&](const char* name, double& v) {
+      ok &= sbot_ros_params::readTypedParam(pnh, name, v, "swarm_manager");
+      if (ok && v < 0) {
+        ROS_FATAL("swarm_manager: ~%s must be >= 0, got %g", name, v);
+        ok = false;
+      }
+    };
     param("lookahead", c.lookahead);
     param("lookbehind", c.lookbehind);
     param("half_width", c.half_width);
@@ -66,9 +75,12 @@ class SwarmManager {
     param("rough_medium", c.rough_medium);
     param("rough_detailed", c.rough_detailed);
     param("demote_delay", c.demote_delay);
-    pnh.param("flat_level", c.flat_level, c.flat_level);
-    pnh.param("medium_level", c.medium_level, c.medium_level);
-    pnh.param("detailed_level", c.detailed_level, c.detailed_level);
+    ok &= sbot_ros_params::readTypedParam(pnh, "flat_level", c.flat_level, "swarm_manager");
+    ok &= sbot_ros_params::readTypedParam(pnh, "medium_level", c.medium_level, "swarm_manager");
+    ok &= sbot_ros_params::readTypedParam(pnh, "detailed_level", c.detailed_level, "swarm_manager");
+    ok &= sbot_ros_params::readTypedParam(pnh, "rate", rate_, "swarm_manager");
+    ok &= sbot_ros_params::readTypedParam(pnh, "detailed_when_gripping", gripping_detailed_, "swarm_manager");
+    if (!ok) return false;
     for (const std::string* l : {&c.flat_level, &c.medium_level, &c.detailed_level}) {
       if (!known(*l)) {
         ROS_FATAL("swarm_manager: unknown level '%s' (levels: fast, simple, basic, medium, detailed)", l->c_str());
@@ -80,9 +92,10 @@ class SwarmManager {
       return false;
     }
     policy_ = std::make_unique<sbot::swarm::LevelPolicy>(c);
-    pnh.param("rate", rate_, 5.0);
-    if (!(rate_ > 0)) rate_ = 5.0;
-    pnh.param("detailed_when_gripping", gripping_detailed_, true);
+    if (!(rate_ > 0)) {
+      ROS_FATAL("swarm_manager: ~rate must be > 0 Hz, got %g", rate_);
+      return false;
+    }
     ROS_INFO("swarm_manager: terrain of %s; levels %s / %s / %s; small gaps <= %.0f mm; look-ahead %.2f m; "
              "demote after %.1f s; %.1f Hz", scenario.c_str(), c.flat_level.c_str(), c.medium_level.c_str(),
              c.detailed_level.c_str(), c.small_gap_max * 1000, c.lookahead, c.demote_delay, rate_);
@@ -122,8 +135,18 @@ class SwarmManager {
   void onGraph(const sbot_msgs::SwarmGraph::ConstPtr& g) {
     const double t = g->header.stamp.toSec();
     if (t < last_ + 1.0 / rate_ - 1e-6 && t >= last_) return;
+    // A message from another publisher can be malformed: the connection matrix was read past its end.
+    if (g->names.size() != g->n || g->positions.size() != g->n || g->connections.size() != std::size_t(g->n) * g->n ||
+        (!g->headings.empty() && g->headings.size() != g->n)) {
+      ROS_WARN_THROTTLE(5, "swarm_manager: /swarm/graph message ignored: n = %u needs %u names and positions, "
+                           "%u connections and 0 or %u headings; it has %zu, %zu, %zu and %zu",
+                        g->n, g->n, g->n * g->n, g->n, g->names.size(), g->positions.size(), g->connections.size(),
+                        g->headings.size());
+      return;
+    }
     last_ = t;
-    for (std::size_t i = 0; i < g->n && i < g->names.size() && i < g->positions.size(); ++i) {
+    for (std::size_t i = 0; i < g->n; ++i) {
+      if (!std::isfinite(g->positions[i].x) || !std::isfinite(g->positions[i].y)) continue;  // no terrain to read there
       bool connected = false;
       for (std::size_t j = 0; j < g->n && gripping_detailed_; ++j)
         connected |= g->connections[i * g->n + j] != 0 || g->connections[j * g->n + i] != 0;

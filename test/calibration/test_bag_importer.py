@@ -67,7 +67,7 @@ class BagImporterTest(unittest.TestCase):
     def tearDownClass(cls):
         shutil.rmtree(cls.tmp, ignore_errors=True)
 
-    def write_bag(self, run, path, with_commands=True, tracker_lead=0.0):
+    def write_bag(self, run, path, with_commands=True, tracker_lead=0.0, nan_pose_at=None):
         rows = read_csv(os.path.join(self.tmp, "src", run + ".csv"))
         base = 1000.0
         with rosbag.Bag(path, "w") as bag:
@@ -80,6 +80,8 @@ class BagImporterTest(unittest.TestCase):
                     m = PoseStamped()
                     m.header.stamp = rospy.Time.from_sec(base + float(r["t"]) - tracker_lead)
                     m.pose.position.x, m.pose.position.y = float(r["x"]), float(r["y"])
+                    if nan_pose_at is not None and abs(float(r["t"]) - nan_pose_at) < 1e-6:
+                        m.pose.position.x = float("nan")
                     yaw = float(r["yaw"])
                     m.pose.orientation.z, m.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
                     bag.write("/tracker/sbot_0", m, t)
@@ -147,6 +149,55 @@ class BagImporterTest(unittest.TestCase):
         with self.assertRaises(SystemExit) as e:
             bag_to_dataset.main([os.path.join(self.tmp, "bad"), path, "--tracker-topic", "/tracker/sbot_0"])
         self.assertIn("command", str(e.exception))
+
+    def test_a_failed_append_leaves_the_dataset_as_it_was(self):
+        # An append that failed half-way (a full disk) used to leave dataset.yaml truncated, losing
+        # the index of the runs already there, and a CSV without its entry.
+        first = os.path.join(self.tmp, "first.bag")
+        self.write_bag("straight_20", first)
+        out = os.path.join(self.tmp, "appended")
+        self.assertEqual(bag_to_dataset.main([out, first, "--tracker-topic", "/tracker/sbot_0"]), 0)
+        with open(os.path.join(out, "dataset.yaml")) as f:
+            before = f.read()
+        second = os.path.join(self.tmp, "second.bag")
+        self.write_bag("straight_20", second)
+        nocmd = os.path.join(self.tmp, "third_nocmd.bag")
+        self.write_bag("straight_20", nocmd, with_commands=False)
+        with self.assertRaises(SystemExit) as e:
+            bag_to_dataset.main([out, second, nocmd, "--append", "--tracker-topic", "/tracker/sbot_0"])
+        self.assertIn("third_nocmd.csv: no command messages", str(e.exception))
+        with open(os.path.join(out, "dataset.yaml")) as f:
+            self.assertEqual(f.read(), before)
+        self.assertEqual(sorted(os.listdir(out)), ["dataset.yaml", "first.csv"], "a file of the failed append is left")
+
+    def test_a_pose_that_is_not_finite_is_refused(self):
+        path = os.path.join(self.tmp, "nan.bag")
+        rows = read_csv(os.path.join(self.tmp, "src", "straight_20.csv"))
+        self.write_bag("straight_20", path, nan_pose_at=float(next(r["t"] for r in rows[3:] if r["x"] != "")))
+        with self.assertRaises(SystemExit) as e:
+            bag_to_dataset.main([os.path.join(self.tmp, "nan_out"), path, "--tracker-topic", "/tracker/sbot_0"])
+        self.assertIn("tracker topic /tracker/sbot_0: message at t = ", str(e.exception))
+        self.assertIn("not finite (nan", str(e.exception))
+        self.assertFalse(os.path.exists(os.path.join(self.tmp, "nan_out")))
+
+    def test_a_topic_of_the_wrong_type_is_named(self):
+        path = os.path.join(self.tmp, "wrongtype.bag")
+        self.write_bag("straight_20", path)
+        with self.assertRaises(SystemExit) as e:  # the tracker's PoseStamped given as the command topic
+            bag_to_dataset.main([os.path.join(self.tmp, "wt_out"), path, "--commands-topic", "/tracker/sbot_0"])
+        self.assertIn("topic /tracker/sbot_0 has type geometry_msgs/PoseStamped, expected sbot_msgs/TrackSpeed",
+                      str(e.exception))
+
+    def test_an_append_onto_runs_that_are_not_runs_is_refused(self):
+        out = os.path.join(self.tmp, "notruns")
+        os.makedirs(out)
+        with open(os.path.join(out, "dataset.yaml"), "w") as f:
+            f.write("format: sbot-dataset/1\nruns: [1, 2]\n")
+        path = os.path.join(self.tmp, "for_notruns.bag")
+        self.write_bag("straight_20", path)
+        with self.assertRaises(SystemExit) as e:
+            bag_to_dataset.main([out, path, "--append", "--tracker-topic", "/tracker/sbot_0"])
+        self.assertIn("runs[0] is not a run", str(e.exception))
 
     def test_unreadable_bag_is_named_and_nothing_is_written(self):
         good = os.path.join(self.tmp, "good.bag")

@@ -19,8 +19,8 @@
 #include <sensor_msgs/Range.h>
 #include <visualization_msgs/MarkerArray.h>
 
-#include "node_params.h"
 #include "ros_conversions.h"
+#include "sbot_sim/ros/typed_param.h"
 
 namespace sbot_node {
 
@@ -625,6 +625,10 @@ bool RobotModulesRos::onSetLeds(sbot_msgs::SetLeds::Request& req, sbot_msgs::Set
 bool RobotModulesRos::onSetSamplingRate(sbot_msgs::SetSamplingRate::Request& req,
                                         sbot_msgs::SetSamplingRate::Response& res) {
   res.success = false;
+  if (!robot_) {  // deleted: answered as the other per-robot services are (it said success)
+    res.message = "robot '" + name_ + "' is not in the simulation";
+    return true;
+  }
   auto it = rates_.find(req.channel);
   if (it == rates_.end()) {
     std::string list;
@@ -687,7 +691,7 @@ bool ModulesRosInterface::checkRateParams(const ros::NodeHandle& pnh) {
       continue;
     }
     double hz = 0;
-    ok &= readTypedParam(pnh, "rates/" + it->first, hz);
+    ok &= sbot_ros_params::readTypedParam(pnh, "rates/" + it->first, hz);
   }
   return ok;
 }

@@ -1,6 +1,5 @@
 #include "sim_ros_interface.h"
 
-#include "node_params.h"
 #include "publication_stamps.h"
 #include "robot_lookup.h"
 
@@ -17,6 +16,7 @@
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/swarm/swarm_graph.h"
+#include "sbot_sim/ros/typed_param.h"
 
 namespace sbot_node {
 
@@ -55,28 +55,35 @@ bool SimRosInterface::readParams() {
     return false;
   }
   // Defaults: SimParams (sim_ros_interface.h).
-  ok &= readTypedParam(pnh_, "robots", params_.robots);
-  ok &= readTypedParam(pnh_, "level", params_.level);
-  ok &= readTypedParam(pnh_, "real_time_factor", params_.real_time_factor);
-  ok &= readTypedParam(pnh_, "duration", params_.duration);
-  ok &= readTypedParam(pnh_, "publish_rate", params_.publish_rate);
-  ok &= readTypedParam(pnh_, "paused", params_.paused);
-  ok &= readTypedParam(pnh_, "set_description_params", params_.set_description_params);
-  ok &= readTypedParam(pnh_, "effects", params_.effects);
-  ok &= readTypedParam(pnh_, "lockstep", params_.lockstep.enabled);
-  ok &= readTypedParam(pnh_, "lockstep_controllers", params_.lockstep.controllers);
-  ok &= readTypedParam(pnh_, "lockstep_timeout", params_.lockstep.timeout);
+  ok &= sbot_ros_params::readTypedParam(pnh_, "robots", params_.robots);
+  ok &= sbot_ros_params::readTypedParam(pnh_, "level", params_.level);
+  ok &= sbot_ros_params::readTypedParam(pnh_, "real_time_factor", params_.real_time_factor);
+  ok &= sbot_ros_params::readTypedParam(pnh_, "duration", params_.duration);
+  ok &= sbot_ros_params::readTypedParam(pnh_, "publish_rate", params_.publish_rate);
+  ok &= sbot_ros_params::readTypedParam(pnh_, "paused", params_.paused);
+  ok &= sbot_ros_params::readTypedParam(pnh_, "set_description_params", params_.set_description_params);
+  ok &= sbot_ros_params::readTypedParam(pnh_, "effects", params_.effects);
+  ok &= sbot_ros_params::readTypedParam(pnh_, "lockstep", params_.lockstep.enabled);
+  ok &= sbot_ros_params::readTypedParam(pnh_, "lockstep_controllers", params_.lockstep.controllers);
+  ok &= sbot_ros_params::readTypedParam(pnh_, "lockstep_timeout", params_.lockstep.timeout);
   {  // Read by the modules, markers and graph publishers (their ranges are checked there): types here.
     bool flag = false;
     int whole = 0;
     double number = 0;
-    ok &= readTypedParam(pnh_, "modules", flag);
-    ok &= readTypedParam(pnh_, "marker_rate", number);
-    ok &= readTypedParam(pnh_, "trail_length", whole);
-    ok &= readTypedParam(pnh_, "graph_rate", number);
-    ok &= readTypedParam(pnh_, "camera/width", whole);
-    ok &= readTypedParam(pnh_, "camera/height", whole);
-    ok &= readTypedParam(pnh_, "camera/internal_scale", whole);
+    ok &= sbot_ros_params::readTypedParam(pnh_, "modules", flag);
+    ok &= sbot_ros_params::readTypedParam(pnh_, "marker_rate", number);
+    ok &= sbot_ros_params::readTypedParam(pnh_, "trail_length", whole);
+    ok &= sbot_ros_params::readTypedParam(pnh_, "graph_rate", number);
+    // The raw camera's buffers are width x height: 100000 x 100000 px ran out of memory mid-run.
+    for (const char* side : {"camera/width", "camera/height"}) {
+      whole = 0;
+      ok &= sbot_ros_params::readTypedParam(pnh_, side, whole);
+      if (whole > 4096) {
+        ROS_FATAL("simulator: ~%s must be <= 4096 px, got %d", side, whole);
+        ok = false;
+      }
+    }
+    ok &= sbot_ros_params::readTypedParam(pnh_, "camera/internal_scale", whole);
     ok &= ModulesRosInterface::checkRateParams(pnh_);
   }
   ROS_INFO("simulator: ~scenario=%s ~robots=%d ~level=%s ~real_time_factor=%g ~duration=%g ~publish_rate=%g "
@@ -419,6 +426,14 @@ bool SimRosInterface::onStep(sbot_msgs::Step::Request& req, sbot_msgs::Step::Res
   if (!paused_) {
     res.success = false;
     res.message = "the simulation is running: call /sim/pause before /sim/step";
+    return true;
+  }
+  // The node serves nothing else while it steps: 2^32 steps held it (and /sim/pause) for days.
+  constexpr std::uint32_t kMaxStepsPerCall = 100000;
+  if (req.steps > kMaxStepsPerCall) {
+    res.success = false;
+    res.message = "steps " + std::to_string(req.steps) + " exceeds " + std::to_string(kMaxStepsPerCall) +
+                  " per call (nothing else is served while it steps): call /sim/step again, or /sim/unpause";
     return true;
   }
   try {

@@ -84,6 +84,14 @@ class TestSimServices(unittest.TestCase):
         self.assertAlmostEqual(after.y, before.y, delta=0.002)
         self.assertAlive()
 
+    def test_step_refuses_counts_that_would_hold_the_node(self):
+        # 2^32 steps held the node, /sim/pause included, for days.
+        res = self.sim.step(4294967295)
+        self.assertFalse(res.success)
+        self.assertIn('steps 4294967295 exceeds 100000 per call', res.message)
+        self.sim.step_ok(self, 1)  # and it still steps
+        self.assertAlive()
+
     def test_step_only_while_paused(self):
         t0 = self.sim.step_ok(self, 1)
         t1 = self.sim.step_ok(self, 10)
