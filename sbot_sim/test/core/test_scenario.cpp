@@ -18,6 +18,12 @@ std::string errorOf(const std::string& yaml) {
   return "";
 }
 
+/// `yaml` is refused with a message that contains `expected`.
+void refused(const std::string& yaml, const std::string& expected) {
+  const std::string e = errorOf(yaml);
+  EXPECT_NE(e.find(expected), std::string::npos) << yaml << "\n  gave: '" << e << "'";
+}
+
 TEST(Scenario, SwarmGridAndExplicitRobots) {
   const Scenario s = parseScenario(R"(
 seed: 5
@@ -69,10 +75,6 @@ TEST(Scenario, ErrorsNameFileAndField) {
 // count that exhausted memory (1e8 robots, resolution 1e5), a name ROS cannot advertise topics
 // under, a gravity pointing up, contact softness outside ODE's ranges.
 TEST(Scenario, RefusesValuesThatWouldMisbehaveLater) {
-  const auto refused = [](const std::string& yaml, const std::string& expected) {
-    const std::string e = errorOf(yaml);
-    EXPECT_NE(e.find(expected), std::string::npos) << yaml << "\n  gave: '" << e << "'";
-  };
   refused("world: {solver_iterations: 1e12}", "'world.solver_iterations': must be a whole number in [1, 100000], found 1e+12");
   refused("world: {solver_iterations: 2.5}", "'world.solver_iterations': must be a whole number");
   refused("swarm: {count: 100000000}", "'swarm.count': must be a whole number in [0, 10000]");
@@ -275,10 +277,6 @@ links: [{holder: holder, held: held, kind: side_arm}]
 // The sensed environment was read by the node alone: an infinite ambient light aborted it, NaN and
 // negative values became 0 without a word, and a bad lamp dropped it and the lamps after it.
 TEST(Scenario, LampsAndAmbientLightAreCheckedByField) {
-  const auto refused = [](const std::string& yaml, const std::string& expected) {
-    const std::string e = errorOf(yaml);
-    EXPECT_NE(e.find(expected), std::string::npos) << yaml << "\n  gave: '" << e << "'";
-  };
   refused("world: {ambient_light: .inf}", "'world.ambient_light': must be finite");
   refused("world: {ambient_light: .nan}", "'world.ambient_light': must be finite");
   refused("world: {ambient_light: -100}", "'world.ambient_light': must be >= 0");
