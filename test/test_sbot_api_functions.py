@@ -31,6 +31,9 @@ class SbotApiFunctions(unittest.TestCase):
         code, out = smoke('/sbot_0')
         self.assertEqual(code, 0, out)
         self.assertIn('SBOT_API_OK', out)
+        # Named with the caller's values (the service's uint8 fields made them 255 and "hz 0").
+        self.assertIn('setLightColor: light group 300 outside [0, 7]', out)
+        self.assertIn('setProximitySamplingRate(0): not a SAMPLING_RATE code', out)
 
     def test_missing_modules_are_reported_once_and_not_waited_for(self):
         code, out = smoke('/sbot_1', 'missing')

@@ -97,6 +97,12 @@ int main(int argc, char **argv) {
   getGripperOpticalBarrier(&in, &ex, &co);
   CHECK(in <= 700 && ex <= 700 && co <= 700, "getGripperOpticalBarrier %u %u %u\n", in, ex, co);
 
+  /* Beyond int16: clamped to the positive limits (a bare cast wrapped 40000 to -25536, the opposite). */
+  setSideArmPos(40000, 0, 60);
+  usleep(1500000);
+  e = ro = d = -9999;
+  getSideArmPos(&e, &ro, &d);
+  CHECK(e > 0, "getSideArmPos elevation %d after setSideArmPos(40000, 0, 60): moved the wrong way\n", e);
   setSideArmPos(0, 20, 60);
   setSideArmOpened();
   setSideArmClosed();
@@ -125,6 +131,11 @@ int main(int argc, char **argv) {
   for (i = 0; i < 8; ++i) CHECK(light[i] <= 700, "light %d = %u\n", i, light[i]);
   CHECK(getLightSensor(4) <= 700, "getLightSensor\n");
   setLightColor(0, 15, 0, 0, BLINKING_RATE_NO_BLINK);
+  /* Out of range: warnings that name the caller's values (the test reads them). */
+  w0 = warnings;
+  setLightColor(300, 15, 0, 0, BLINKING_RATE_NO_BLINK);
+  setProximitySamplingRate(0);
+  CHECK(warnings >= w0 + 2, "setLightColor(300, ...) and setProximitySamplingRate(0) gave no warnings\n");
   setAllLightColor(rr, gg, bb, blink);
   setSameLightColor(0, 15, 0, BLINKING_RATE_1);
 

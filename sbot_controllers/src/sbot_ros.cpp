@@ -361,9 +361,11 @@ bool call(const char* service, Srv& srv, const char* fn) {
 }
 
 void setRate(const char* channel, SamplingRate rate, const char* fn) {
-  // Named with the caller's value: the uint8 field made 999 read "code 255" in the reply.
-  if (static_cast<unsigned>(rate) > 255) {
-    report(false, "%s(%u): not a SAMPLING_RATE code", fn, static_cast<unsigned>(rate));
+  // Named with the caller's value: the uint8 field made 999 read "code 255" in the reply, and 0
+  // (the service's "use hz") read "hz must be > 0".
+  if (static_cast<unsigned>(rate) < SAMPLING_RATE_50 || static_cast<unsigned>(rate) > SAMPLING_RATE_0_5) {
+    report(false, "%s(%u): not a SAMPLING_RATE code (SAMPLING_RATE_50 = 1 .. SAMPLING_RATE_0_5 = 8)", fn,
+           static_cast<unsigned>(rate));
     return;
   }
   sbot_msgs::SetSamplingRate srv;
