@@ -87,14 +87,8 @@ Vec3 vec3(const YAML::Node& n, const std::string& file, const std::string& field
 
 void allowOnly(const YAML::Node& n, const std::string& file, const std::string& field,
                const std::set<std::string>& keys) {
-  for (const auto& kv : n) {
-    const std::string k = kv.first.as<std::string>();
-    if (!keys.count(k)) {
-      std::string list;
-      for (const auto& a : keys) list += (list.empty() ? "" : ", ") + a;
-      fail(file, kv.first, field.empty() ? k : field + "." + k, "unknown field (expected one of: " + list + ")");
-    }
-  }
+  if (const YAML::Node k = unknownKey(n, keys))
+    fail(file, k, field.empty() ? k.Scalar() : field + "." + k.Scalar(), unknownFieldMessage(keys));
 }
 
 std::string defaultGroup(const std::string& name) {

@@ -168,19 +168,6 @@ JointDescription convertJoint(const urdf::Joint& j, const std::string& file) {
   return out;
 }
 
-/// Keys of a sidecar mapping other than `allowed` are typos or leftovers: refused by name.
-void allowOnly(const YAML::Node& node, const std::vector<std::string>& allowed, const std::string& file,
-               const std::string& prefix) {
-  if (!node || !node.IsMap()) return;
-  for (const auto& kv : node) {
-    const std::string key = kv.first.as<std::string>();
-    if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
-    std::string list;
-    for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-    throw ConfigError(file, prefix + key, "unknown field (expected one of: " + list + ")");
-  }
-}
-
 /// The sidecar's `extra` entries: what each may hold. The modules read most of them (sensor
 /// constants, models, solver iterations); the counts of the seed's tables (ir_count, mic_count,
 /// led_groups, camera size, reading maxima) document the hardware and are checked all the same, so
@@ -249,9 +236,9 @@ void checkExtra(const YAML::Node& e, const std::string& file) {
     const std::string key = kv.first.as<std::string>(), field = "extra." + key;
     const auto rule = std::find_if(rules.begin(), rules.end(), [&](const ExtraRule& r) { return key == r.key; });
     if (rule == rules.end()) {
-      std::string list;
-      for (const auto& r : rules) list += (list.empty() ? "" : ", ") + std::string(r.key);
-      throw ConfigError(file, field, "unknown field (expected one of: " + list + ")");
+      std::set<std::string> known;
+      for (const auto& r : rules) known.insert(r.key);
+      throw ConfigError(file, field, unknownFieldMessage(known));
     }
     if (!kv.second.IsScalar()) throw ConfigError(file, field, "expected a single value");
     const std::string text = kv.second.Scalar();
@@ -309,8 +296,9 @@ void parseSidecar(RobotDescription& d) {
   }
   if (const std::string problem = yamlStructureProblem(root); !problem.empty()) throw ConfigError(file, "", problem);
   if (!root.IsMap()) throw ConfigError(file, "", "expected a mapping at the top level");
-  allowOnly(root, {"level", "recommended_step", "gravity", "treels", "turret", "materials", "extra", "gripper", "side_arm"},
-            file, "");
+  const std::set<std::string> sections{"level",     "recommended_step", "gravity", "treels", "turret",
+                                       "materials", "extra",            "gripper", "side_arm"};
+  if (const YAML::Node key = unknownKey(root, sections)) throw ConfigError(file, key.Scalar(), unknownFieldMessage(sections));
   d.level = get<std::string>(root, "level", "", file, "");
   if (d.level.empty()) throw ConfigError(file, "level", "missing");
   d.recommended_step = get<double>(root, "recommended_step", 0.01, file, "");

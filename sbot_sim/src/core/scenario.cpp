@@ -91,14 +91,7 @@ class Fields {
   /// Typos in scenario files should not be silently ignored.
   void allowOnly(const std::set<std::string>& keys) const {
     if (!present_) return;
-    for (const auto& kv : node_) {
-      const auto k = kv.first.as<std::string>();
-      if (!keys.count(k)) {
-        std::string list;
-        for (const auto& a : keys) list += (list.empty() ? "" : ", ") + a;
-        throw ConfigError(file_, path(k), "unknown field (expected one of: " + list + ")");
-      }
-    }
+    if (const YAML::Node k = unknownKey(node_, keys)) throw ConfigError(file_, path(k.Scalar()), unknownFieldMessage(keys));
   }
 
  private:

@@ -55,4 +55,17 @@ std::string yamlStructureProblem(const YAML::Node& node) {
   return problemIn(node, w);
 }
 
+YAML::Node unknownKey(const YAML::Node& node, const std::set<std::string>& allowed) {
+  if (node && node.IsMap())
+    for (const auto& kv : node)
+      if (!allowed.count(kv.first.as<std::string>())) return kv.first;
+  return YAML::Node(YAML::NodeType::Undefined);  // false (a default Node is a defined null)
+}
+
+std::string unknownFieldMessage(const std::set<std::string>& allowed) {
+  std::string list;
+  for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+  return "unknown field (expected one of: " + list + ")";
+}
+
 }  // namespace sbot

@@ -1,6 +1,7 @@
 // Checks on parsed YAML that yaml-cpp does not make itself.
 #pragma once
 
+#include <set>
 #include <string>
 
 #include <yaml-cpp/yaml.h>
@@ -16,5 +17,12 @@ namespace sbot {
 /// - aliases nested to multiply the document past a million values ("billion laughs"), which made
 ///   a walk run for hours.
 std::string yamlStructureProblem(const YAML::Node& node);
+
+/// The first key of mapping `node` that is not in `allowed` (its name: Scalar(), its place: Mark()),
+/// or an undefined node (false) when every key is (or `node` is no mapping): a typo or a leftover, which a loader
+/// must not ignore. unknownFieldMessage words it.
+YAML::Node unknownKey(const YAML::Node& node, const std::set<std::string>& allowed);
+/// "unknown field (expected one of: a, b, c)".
+std::string unknownFieldMessage(const std::set<std::string>& allowed);
 
 }  // namespace sbot
