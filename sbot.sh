@@ -94,7 +94,7 @@ demo() {
   # machine cannot keep up with 20 robots' topics and drops messages.
   roslaunch -p "$port" "$ROOT/launch/swarm.launch" headless:=true record:=true duration:=30 \
       real_time_factor:=2 publish_rate:=20 bag:="$out/demo.bag" robots:=20 >"$out/roslaunch.log" 2>&1 || true
-  grep -h "simulator: " "$out/roslaunch.log" | sed 's/^.*simulator: /simulator: /' || true
+  grep -h "simulator: " "$out/roslaunch.log" | sed -e 's/^.*simulator: /simulator: /' -e 's/\x1b\[[0-9;]*m//g' || true  # without the log's colour codes
   [[ -f "$out/demo.bag" ]] || { tail -n 40 "$out/roslaunch.log"; log "demo failed: no bag written"; exit 1; }
   "$PY" "$ROOT/src/bag_summary.py" "$out/demo.bag"
 }

@@ -223,10 +223,11 @@ int main(int argc, char** argv) {
     }
     double sx = 0, sy = 0;
     for (std::size_t i = 0; i < w.x.size(); ++i) { sx += w.x[i] / w.x.size(); sy += w.y[i] / w.y.size(); }
-    char line[640];
+    char line[1024];
     std::snprintf(line, sizeof(line),
-                  "wall time  detailed / switching = %.2f / %.2f s = %.2fx less (bar: >= 4x)\n"
-                  "CPU time   detailed / switching = %.2f / %.2f s = %.2fx less\n"
+                  "wall time  detailed / switching = %.2f / %.2f s = %.2fx less\n"
+                  "CPU time   detailed / switching = %.2f / %.2f s = %.2fx less (bar: >= 4x, on CPU time: other "
+                  "processes do not inflate it)\n"
                   "final position: detailed mean (%.4f, %.4f), spread (max distance to its mean) %.4f m;\n"
                   "  switching mean (%.4f, %.4f): %.4f m from the detailed mean; switched runs' distance to the\n"
                   "  detailed mean: mean %.4f m, worst %.4f m (bar: <= max(0.05, detailed spread) = %.4f m)\n"
