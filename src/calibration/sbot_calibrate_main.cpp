@@ -444,7 +444,8 @@ int cmdDiagnose(const Args& a) {
     }
   }
   std::printf("\n%s", r.verdict.c_str());
-  std::printf("diagnose took %.1f s wall, %d run simulations, %d worker processes", r.seconds, r.simulations, pool.size());
+  std::printf("diagnose took %.1f s wall, %d run simulations, %d worker process%s", r.seconds, r.simulations, pool.size(),
+              pool.size() == 1 ? "" : "es");
   if (results.size() > 1)
     std::printf(" (round %d; %.1f s for all %zu rounds)", rounds.round,
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), results.size());
