@@ -332,6 +332,7 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
       s.robots.push_back(spawn);
     }
   }
+  std::set<std::string> dropped;  // listed robots the count override leaves out (no swarm section)
   if (const YAML::Node swarm = f.node("swarm")) {
     Fields sw(swarm, "swarm", file);
     sw.allowOnly({"count", "level", "layout", "spacing", "center", "area"});
@@ -369,6 +370,7 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
       s.robots.push_back(spawn);
     }
   } else if (robot_count >= 0 && static_cast<int>(s.robots.size()) > robot_count) {
+    for (std::size_t i = robot_count; i < s.robots.size(); ++i) dropped.insert(s.robots[i].name);
     s.robots.resize(robot_count);
   }
   std::set<std::string> names;
@@ -387,6 +389,9 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
       for (const auto* n : {&link.holder, &link.held}) {
         const std::string field = l.path(n == &link.holder ? "holder" : "held");
         if (n->empty()) throw ConfigError(file, field, "required");
+        if (dropped.count(*n))
+          throw ConfigError(file, field, "robot '" + *n + "' is left out by the robot count override " +
+                                             std::to_string(robot_count) + " (~robots): the link needs it");
         if (!names.count(*n)) throw ConfigError(file, field, "unknown robot '" + *n + "'");
       }
       if (link.holder == link.held) throw ConfigError(file, path, "a robot cannot grip itself");

@@ -53,6 +53,16 @@ TEST(Scenario, RobotCountOverride) {
   for (std::size_t i = 0; i < s.robots.size(); ++i)
     for (std::size_t j = i + 1; j < s.robots.size(); ++j)
       EXPECT_GE(std::hypot(s.robots[i].pose.x - s.robots[j].pose.x, s.robots[i].pose.y - s.robots[j].pose.y), 0.3);
+  // A link to a listed robot the override leaves out said "unknown robot" of a robot in the file.
+  const std::string linked = "robots: [{name: a, pose: {x: 0, y: 0, yaw: 0}}, {name: b, pose: {x: 1, y: 0, yaw: 0}}]\n"
+                             "links: [{holder: a, held: b}]\n";
+  try {
+    parseScenario(linked, "x.yaml", 1);
+    ADD_FAILURE() << "a link to a robot left out was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("'links[0].held': robot 'b' is left out by the robot count override 1"),
+              std::string::npos) << e.what();
+  }
 }
 
 TEST(Scenario, ErrorsNameFileAndField) {
