@@ -46,7 +46,10 @@ def main():
     try:
         topics, robots, travelled, final, (t0, t1) = summarise(args.bag)
     except Exception as error:  # rosbag raises several unrelated types for unreadable files
-        print('bag_summary: cannot read %s: %s' % (args.bag, error), file=sys.stderr)
+        # What rosbag's own words leave out for the two commonest cases (a cut-off recording, not a bag).
+        hint = {'ROSBagUnindexedException': ' (a recording cut off: `rosbag reindex` repairs it)',
+                'UnicodeDecodeError': ' (not a rosbag)'}.get(type(error).__name__, '')
+        print('bag_summary: cannot read %s: %s%s' % (args.bag, error, hint), file=sys.stderr)
         return 1
     print('bag: %s' % args.bag)
     print('topics: %d' % len(topics))

@@ -128,6 +128,22 @@ class SwarmRecordTest(unittest.TestCase):
             self.assertEqual(result.returncode, 1, 'bag_summary.py should exit 1 on %s, got %s:\n%s'
                              % (os.path.basename(path), result.returncode, result.stdout))
 
+    def test_5_bag_summary_names_a_cut_off_bag_and_a_non_bag(self):
+        # rosbag's own words ("Unindexed bag", a utf-8 codec error) did not say what to do or what it was.
+        self.topics()
+        cut = os.path.join(self.tmp, 'cut.bag')
+        garbage = os.path.join(self.tmp, 'garbage.bag')
+        with open(self.bag_path, 'rb') as f:
+            data = f.read()
+        with open(cut, 'wb') as f:
+            f.write(data[:len(data) // 2])
+        with open(garbage, 'wb') as f:
+            f.write(bytes(range(128, 256)) * 32)
+        for path, says in ((cut, 'rosbag reindex'), (garbage, 'not a rosbag')):
+            result = self.bag_summary(path)
+            self.assertEqual(result.returncode, 1, result.stdout)
+            self.assertIn(says, result.stdout)
+
 
 if __name__ == '__main__':
     rostest.rosrun(PKG, 'test_swarm_record', SwarmRecordTest)

@@ -213,7 +213,10 @@ def main(argv=None):
         try:
             rows, pose, missing = read_run(bag, topics)
         except Exception as error:  # rosbag raises several unrelated types for unreadable files
-            raise SystemExit("bag_to_dataset: cannot read %s: %s" % (bag, error))
+            # What rosbag's own words leave out for the two commonest cases (a cut-off recording, not a bag).
+            hint = {"ROSBagUnindexedException": " (a recording cut off: `rosbag reindex` repairs it)",
+                    "UnicodeDecodeError": " (not a rosbag)"}.get(type(error).__name__, "")
+            raise SystemExit("bag_to_dataset: cannot read %s: %s%s" % (bag, error, hint))
         if not rows:
             raise SystemExit("%s: none of the topics %s is in the bag" % (bag, sorted(t for t in topics.values() if t)))
         imported.append((bag, rows, pose, missing))
