@@ -623,6 +623,20 @@ void Robot::setBasePose(const Pose& pose) {
   }
 }
 
+std::vector<Robot::BodyState> Robot::bodyStates() const {
+  std::vector<BodyState> out;
+  for (dBodyID b : bodies_) out.push_back({bodyPose(b), vec(dBodyGetLinearVel(b)), vec(dBodyGetAngularVel(b))});
+  return out;
+}
+
+void Robot::setBodyStates(const std::vector<BodyState>& states) {
+  for (std::size_t i = 0; i < bodies_.size() && i < states.size(); ++i) {
+    setBodyPose(bodies_[i], states[i].pose);
+    dBodySetLinearVel(bodies_[i], states[i].linear.x(), states[i].linear.y(), states[i].linear.z());
+    dBodySetAngularVel(bodies_[i], states[i].angular.x(), states[i].angular.y(), states[i].angular.z());
+  }
+}
+
 // ---- stepping ------------------------------------------------------------------------------------
 
 void Robot::applyCommands(double dt, const std::vector<EffectPtr>& effects) {

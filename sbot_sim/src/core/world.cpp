@@ -554,32 +554,11 @@ std::string World::robotsOverlapProblem() const {
 }
 
 std::string World::placeRobot(Robot& robot, const Pose& pose) {
-  struct BodyState {
-    dVector3 position, linear, angular;
-    dQuaternion orientation;
-  };
-  std::vector<BodyState> before(robot.bodies().size());
-  for (std::size_t i = 0; i < before.size(); ++i) {
-    const dBodyID b = robot.bodies()[i];
-    BodyState& s = before[i];
-    for (int k = 0; k < 3; ++k) {
-      s.position[k] = dBodyGetPosition(b)[k];
-      s.linear[k] = dBodyGetLinearVel(b)[k];
-      s.angular[k] = dBodyGetAngularVel(b)[k];
-    }
-    for (int k = 0; k < 4; ++k) s.orientation[k] = dBodyGetQuaternion(b)[k];
-  }
+  const std::vector<Robot::BodyState> before = robot.bodyStates();
   robot.setBasePose(pose);
   const Overlap o = deepestOverlap(robot);
   if (o.depth <= kPlacementTolerance) return "";
-  for (std::size_t i = 0; i < before.size(); ++i) {
-    const dBodyID b = robot.bodies()[i];
-    const BodyState& s = before[i];
-    dBodySetPosition(b, s.position[0], s.position[1], s.position[2]);
-    dBodySetQuaternion(b, s.orientation);
-    dBodySetLinearVel(b, s.linear[0], s.linear[1], s.linear[2]);
-    dBodySetAngularVel(b, s.angular[0], s.angular[1], s.angular[2]);
-  }
+  robot.setBodyStates(before);
   std::ostringstream why;
   why << "robot '" << robot.name() << "' there would sit " << std::fixed << std::setprecision(3) << o.depth
       << " m deep inside " << o.with << " (at most " << kPlacementTolerance << " m): not moved";

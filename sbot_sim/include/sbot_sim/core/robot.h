@@ -119,6 +119,13 @@ class Robot {
 
   /// Move the robot so base_link sits at `pose` with zero velocity (teleport).
   void setBasePose(const Pose& pose);
+  /// Every body's pose and velocities, to put the robot back exactly (World::placeRobot).
+  struct BodyState {
+    Pose pose;
+    Vec3 linear, angular;  ///< [m/s], [rad/s] world frame
+  };
+  std::vector<BodyState> bodyStates() const;
+  void setBodyStates(const std::vector<BodyState>& states);
 
   // ---- joint access for actuator modules (core/actuators: gripper, side arm) --------------------
   /// ODE hinge of a moving URDF joint, nullptr if the level has no such joint. Hinges other than the
