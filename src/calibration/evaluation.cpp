@@ -176,8 +176,63 @@ Evaluation evaluate(const Dataset& ds, const ModelSpec& model, const std::vector
   return ev;
 }
 
+namespace {
+/// Per channel, (sum of squares, count) of (b - a) / sigma: how far replay b lies from replay a in noise units.
+using ChannelSums = std::map<std::string, std::pair<double, double>>;
+ChannelSums normalisedDifference(const Dataset& ds, const RunPrediction& a, const RunPrediction& b) {
+  ChannelSums out;
+  for (const auto& [c, pa] : a.values) {
+    const auto it = b.values.find(c);
+    if (it == b.values.end()) continue;
+    auto& [ss, n] = out[c];
+    for (std::size_t i = 0; i < pa.size() && i < it->second.size(); ++i) {
+      if (!std::isfinite(pa[i]) || !std::isfinite(it->second[i])) continue;
+      const double sigma = ds.noise.sigma(c, pa[i]);
+      if (!(sigma > 0)) continue;
+      const double d = c == "yaw" ? wrapAngle(it->second[i] - pa[i]) : it->second[i] - pa[i];
+      ss += (d / sigma) * (d / sigma);
+      n += 1;
+    }
+  }
+  return out;
+}
+
+/// The nRMS over every channel and the channel that moved most.
+ReplaySensitivity sensitivityOf(int run, const ChannelSums& channels) {
+  ReplaySensitivity r;
+  r.run = run;
+  double ss = 0, n = 0;
+  for (const auto& [c, v] : channels) {
+    ss += v.first;
+    n += v.second;
+    const double rms = v.second > 0 ? std::sqrt(v.first / v.second) : 0.0;
+    if (rms > r.worst_nrms || r.worst_channel.empty()) {
+      r.worst_nrms = rms;
+      r.worst_channel = c;
+    }
+  }
+  r.nrms = n > 0 ? std::sqrt(ss / n) : 0.0;
+  return r;
+}
+}  // namespace
+
+// WorkerPool::map carries results through pipes (found by argument-dependent lookup: not in the
+// unnamed namespace).
+void save(Writer& w, const ReplaySensitivity& r) {
+  save(w, r.run);
+  save(w, r.nrms);
+  save(w, r.worst_channel);
+  save(w, r.worst_nrms);
+}
+void load(Reader& r, ReplaySensitivity& s) {
+  load(r, s.run);
+  load(r, s.nrms);
+  load(r, s.worst_channel);
+  load(r, s.worst_nrms);
+}
+
 std::vector<ReplaySensitivity> replaySensitivity(const Dataset& ds, const ModelSpec& model, const EvalOptions& opt,
-                                                 WorkerPool& pool) {
+                                                 WorkerPool& pool, const std::vector<double>& sides) {
   std::vector<int> drive;
   for (int i = 0; i < static_cast<int>(ds.runs.size()); ++i)
     if (ds.runs[i].kind == RunKind::Drive) drive.push_back(i);
@@ -185,61 +240,21 @@ std::vector<ReplaySensitivity> replaySensitivity(const Dataset& ds, const ModelS
   ro.keep_trace = false;
   if (opt.world_override) ro.world_override = opt.world_override;
   const double nudge_xy = kStartNudge * ds.noise.sigma("x", 0), nudge_yaw = kStartNudge * ds.noise.sigma("yaw", 0);
-  // Per replay from a nudged start: the channels' names and their (sum of squares, count) of the
-  // difference to the replay from the measured start, summed over channels last.
-  using ChannelSums = std::map<std::string, std::pair<double, double>>;
-  const auto sums = pool.map<std::vector<ChannelSums>>(drive.size(), [&](std::size_t k) {
+  return pool.map<ReplaySensitivity>(drive.size(), [&](std::size_t k) {
     const Run& run = ds.runs[drive[k]];
     const RunPrediction a = replayRun(ds, run, model, ro);
-    std::vector<ChannelSums> per_nudge;
-    // Both sides: a threshold (a tip, which contact comes first) may lie on one side of the start only.
-    for (const double side : {1.0, -1.0}) {
+    ReplaySensitivity most;  // the side whose nudge moved the prediction most
+    most.run = drive[k];
+    for (const double side : sides) {
       Run nudged = run;
       nudged.initial_pose.x += side * nudge_xy;
       nudged.initial_pose.y += side * nudge_xy;
       nudged.initial_pose.yaw += side * nudge_yaw;
-      const RunPrediction b = replayRun(ds, nudged, model, ro);
-      ChannelSums out;
-      for (const auto& [c, pa] : a.values) {
-        const auto it = b.values.find(c);
-        if (it == b.values.end()) continue;
-        auto& [ss, n] = out[c];
-        for (std::size_t i = 0; i < pa.size() && i < it->second.size(); ++i) {
-          if (!std::isfinite(pa[i]) || !std::isfinite(it->second[i])) continue;
-          const double sigma = ds.noise.sigma(c, pa[i]);
-          if (!(sigma > 0)) continue;
-          const double d = c == "yaw" ? wrapAngle(it->second[i] - pa[i]) : it->second[i] - pa[i];
-          ss += (d / sigma) * (d / sigma);
-          n += 1;
-        }
-      }
-      per_nudge.push_back(std::move(out));
-    }
-    return per_nudge;
-  });
-  std::vector<ReplaySensitivity> res;
-  for (std::size_t k = 0; k < drive.size(); ++k) {
-    ReplaySensitivity most;  // the nudge that moved the prediction most
-    most.run = drive[k];
-    for (const ChannelSums& channels : sums[k]) {
-      ReplaySensitivity r;
-      r.run = drive[k];
-      double ss = 0, n = 0;
-      for (const auto& [c, v] : channels) {
-        ss += v.first;
-        n += v.second;
-        const double rms = v.second > 0 ? std::sqrt(v.first / v.second) : 0.0;
-        if (rms > r.worst_nrms || r.worst_channel.empty()) {
-          r.worst_nrms = rms;
-          r.worst_channel = c;
-        }
-      }
-      r.nrms = n > 0 ? std::sqrt(ss / n) : 0.0;
+      const ReplaySensitivity r = sensitivityOf(drive[k], normalisedDifference(ds, a, replayRun(ds, nudged, model, ro)));
       if (r.nrms > most.nrms || most.worst_channel.empty()) most = r;
     }
-    res.push_back(most);
-  }
-  return res;
+    return most;
+  });
 }
 
 std::string describeChaoticRuns(const Dataset& ds, const std::vector<ReplaySensitivity>& s) {

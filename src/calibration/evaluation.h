@@ -96,9 +96,10 @@ constexpr double kStartNudge = 1.0;
 constexpr double kChaoticSensitivity = 1.0;  ///< above: the start moved the prediction more than the noise
 
 /// The sensitivity of every drive run (place runs have no dynamics to diverge), with the replay
-/// options of `opt` (alignment, hidden world).
+/// options of `opt` (alignment, hidden world): the largest over the nudges `sides` (in units of
+/// kStartNudge; both ways by default, a single side to see what each contributes).
 std::vector<ReplaySensitivity> replaySensitivity(const Dataset& ds, const ModelSpec& model, const EvalOptions& opt,
-                                                 WorkerPool& pool);
+                                                 WorkerPool& pool, const std::vector<double>& sides = {1.0, -1.0});
 
 /// The runs above kChaoticSensitivity, most sensitive first, e.g. "arc_left 21 (yaw 40)"; empty if none.
 std::string describeChaoticRuns(const Dataset& ds, const std::vector<ReplaySensitivity>& s);
