@@ -395,17 +395,6 @@ RunPrediction replayPlace(World& world, const RobotDescription& d, const Dataset
 namespace {
 std::atomic<long> g_replays{0};
 
-/// ODE's default step threading implementation is process-global and not safe when several worlds
-/// step at once in different threads; give each replayed world its own self-threaded one. Declared
-/// before the World so it outlives it. (Requested core change: World should do this itself.)
-struct PerWorldThreading {
-  dThreadingImplementationID impl = dThreadingAllocateSelfThreadedImplementation();
-  void attach(World& w) {
-    dWorldSetStepThreadingImplementation(w.odeWorld(), dThreadingImplementationGetFunctions(impl), impl);
-  }
-  ~PerWorldThreading() { dThreadingFreeImplementation(impl); }
-};
-
 /// True when the run measures sensors whose readings depend on where the robot is (IR, ground, light).
 bool readsTheWorld(const Run& run) {
   for (const auto& [c, s] : run.channels) {
@@ -448,10 +437,8 @@ double levelTrackWidth(const std::string& level) {
   auto it = cache.find(level);
   if (it != cache.end()) return it->second;
   const RobotDescription& d = loadLevel(level);
-  PerWorldThreading threading;
   WorldConfig c;
   World w(c);
-  threading.attach(w);
   const double width = trackWidthOf(w.addRobot(d, {0, 0, 0}, "probe"));
   cache[level] = width;
   return width;
@@ -459,10 +446,8 @@ double levelTrackWidth(const std::string& level) {
 
 std::vector<std::pair<Vec3, double>> levelIrSensors(const std::string& level) {
   const RobotDescription& d = loadLevel(level);
-  PerWorldThreading threading;
   WorldConfig c;
   World w(c);
-  threading.attach(w);
   Robot& r = w.addRobot(d, {0, 0, 0}, "probe");
   const Pose inv = r.basePose().inverse();
   std::vector<std::pair<Vec3, double>> out;
@@ -489,9 +474,7 @@ RunPrediction replayRun(const Dataset& ds, const Run& run, const ModelSpec& mode
   auto simulate = [&](const Pose2D& start) {
     ++g_replays;
     WorkerPool::count();
-    PerWorldThreading threading;
-    World world(wc);
-    threading.attach(world);
+      World world(wc);
     if (opt.tilt != 0) {
       const double g = wc.gravity;
       dWorldSetGravity(world.odeWorld(), g * std::sin(opt.tilt) * std::cos(opt.tilt_direction),
