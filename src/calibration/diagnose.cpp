@@ -87,14 +87,9 @@ struct FitTask {
   FitResult fit;
   Evaluation heldout;
 };
-void save(Writer& w, const FitTask& t) {
-  save(w, t.fit);
-  save(w, t.heldout);
-}
-void load(Reader& r, FitTask& t) {
-  load(r, t.fit);
-  load(r, t.heldout);
-}
+constexpr auto kFitTaskMembers = std::make_tuple(&FitTask::fit, &FitTask::heldout);
+void save(Writer& w, const FitTask& x) { saveMembers(w, x, kFitTaskMembers); }
+void load(Reader& r, FitTask& x) { loadMembers(r, x, kFitTaskMembers); }
 
 /// Merge per-fold held-out evaluations into one evaluation over all runs.
 Evaluation merge(const std::vector<Evaluation>& parts) {

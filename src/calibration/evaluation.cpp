@@ -218,18 +218,11 @@ ReplaySensitivity sensitivityOf(int run, const ChannelSums& channels) {
 
 // WorkerPool::map carries results through pipes (found by argument-dependent lookup: not in the
 // unnamed namespace).
-void save(Writer& w, const ReplaySensitivity& r) {
-  save(w, r.run);
-  save(w, r.nrms);
-  save(w, r.worst_channel);
-  save(w, r.worst_nrms);
-}
-void load(Reader& r, ReplaySensitivity& s) {
-  load(r, s.run);
-  load(r, s.nrms);
-  load(r, s.worst_channel);
-  load(r, s.worst_nrms);
-}
+constexpr auto kReplaySensitivityMembers =
+    std::make_tuple(&ReplaySensitivity::run, &ReplaySensitivity::nrms, &ReplaySensitivity::worst_channel,
+                    &ReplaySensitivity::worst_nrms);
+void save(Writer& w, const ReplaySensitivity& x) { saveMembers(w, x, kReplaySensitivityMembers); }
+void load(Reader& r, ReplaySensitivity& x) { loadMembers(r, x, kReplaySensitivityMembers); }
 
 std::vector<ReplaySensitivity> replaySensitivity(const Dataset& ds, const ModelSpec& model, const EvalOptions& opt,
                                                  WorkerPool& pool, const std::vector<double>& sides) {

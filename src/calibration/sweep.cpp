@@ -60,46 +60,15 @@ void poolFailingChannels(const DiagnoseResult& r, const Evaluation& floor_eval, 
 
 }  // namespace
 
-void save(Writer& w, const SeedOutcome& o) {
-  save(w, o.seed);
-  save(w, o.accepted);
-  save(w, o.estimate);
-  save(w, o.truth);
-  save(w, o.rms_before);
-  save(w, o.rms_after);
-  save(w, o.floor);
-  save(w, o.failing_channels);
-  save(w, o.failing_before);
-  save(w, o.failing_after);
-  save(w, o.failing_floor);
-  save(w, o.structure_flagged);
-  save(w, o.seconds);
-  save(w, o.verdict);
-  save(w, o.left_out);
-  save(w, o.readmitted);
-  save(w, o.round);
-  save(w, o.rounds);
-}
-void load(Reader& r, SeedOutcome& o) {
-  load(r, o.seed);
-  load(r, o.accepted);
-  load(r, o.estimate);
-  load(r, o.truth);
-  load(r, o.rms_before);
-  load(r, o.rms_after);
-  load(r, o.floor);
-  load(r, o.failing_channels);
-  load(r, o.failing_before);
-  load(r, o.failing_after);
-  load(r, o.failing_floor);
-  load(r, o.structure_flagged);
-  load(r, o.seconds);
-  load(r, o.verdict);
-  load(r, o.left_out);
-  load(r, o.readmitted);
-  load(r, o.round);
-  load(r, o.rounds);
-}
+constexpr auto kSeedOutcomeMembers =
+    std::make_tuple(&SeedOutcome::seed, &SeedOutcome::accepted, &SeedOutcome::estimate, &SeedOutcome::truth,
+                    &SeedOutcome::rms_before, &SeedOutcome::rms_after, &SeedOutcome::floor,
+                    &SeedOutcome::failing_channels, &SeedOutcome::failing_before, &SeedOutcome::failing_after,
+                    &SeedOutcome::failing_floor, &SeedOutcome::structure_flagged, &SeedOutcome::seconds,
+                    &SeedOutcome::verdict, &SeedOutcome::left_out, &SeedOutcome::readmitted, &SeedOutcome::round,
+                    &SeedOutcome::rounds);
+void save(Writer& w, const SeedOutcome& x) { saveMembers(w, x, kSeedOutcomeMembers); }
+void load(Reader& r, SeedOutcome& x) { loadMembers(r, x, kSeedOutcomeMembers); }
 
 std::vector<SweepCase> standardCases(const std::string&) {
   using K = SweepCase::Kind;
