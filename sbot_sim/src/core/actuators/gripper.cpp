@@ -15,8 +15,6 @@ constexpr double kDeg = M_PI / 180.0;
 constexpr double kServoGain = 10.0;     ///< [1/s] position error to velocity
 constexpr double kProbeRadius = 0.008;  ///< [m] around the grip point
 constexpr double kJawProbeRadius = 0.015;  ///< [m] the jaws reach around the ring
-constexpr double kStallRate = 0.05;     ///< [rad/s] jaws considered stopped below
-constexpr double kStallTime = 0.1;      ///< [s]
 
 struct ProbeData {
   const Robot* self;
@@ -99,7 +97,7 @@ bool FrontGripper::setAperture(int degrees) {
     world_.connections().release(robot_.name(), Connection::FrontGripper);
   } else {
     closing_ = true;  // seed: the connection is decided by the closing command
-    stall_time_ = 0;
+    stall_.reset();
     close_elapsed_ = 0;
     close_delay_ = type_ == Type::Jaws ? getAperture() * kDeg / 2.0 / jaw_speed_ : 0.0;
   }
@@ -205,9 +203,9 @@ void FrontGripper::update(double dt) {
     // The seed's time delay: the jaws need (current half-aperture) / jaw_speed to close; they are
     // done when they reach the target, stall on the ring, or that time (+0.1 s) has passed.
     const bool reached = getAperture() <= cmd_aperture_ + 1;
-    stall_time_ = moving < kStallRate ? stall_time_ + dt : 0.0;
+    const bool stalled = stall_.update(moving, dt);
     close_elapsed_ += dt;
-    if (reached || stall_time_ >= kStallTime || close_elapsed_ >= close_delay_ + kStallTime) {
+    if (reached || stalled || close_elapsed_ >= close_delay_ + JawStall::kTime) {
       if (!gripping()) tryConnect();
       closing_ = false;
       jaws_holding_ = gripping();

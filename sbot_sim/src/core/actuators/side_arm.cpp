@@ -9,8 +9,8 @@ namespace sbot {
 namespace actuators {
 
 namespace {
-constexpr double kStallRate = 0.05;
-constexpr double kStallTime = 0.1;
+// A held connection lets go when the force on it, low-passed over kForceFilter, exceeds kBreakMargin
+// times the jaws' grasping force (side_arm.h: Table 2.5's 1 N with a friction-cone margin).
 constexpr double kBreakMargin = 5.0;
 constexpr double kForceFilter = 0.1;  ///< [s]
 constexpr double kProbeRadius = 0.012;  ///< [m] around the grip point between the jaws
@@ -133,7 +133,7 @@ void SideArm::setClosed() {
   if (!available_) return;
   closed_cmd_ = true;
   closing_ = true;
-  stall_time_ = 0;
+  stall_.reset();
 }
 
 BarrierReading SideArm::getOpticalBarrier() const {
@@ -160,8 +160,8 @@ void SideArm::update(double dt) {
   if (closing_) {
     const double moving = std::max(std::abs(robot_.jointRate(j_jaw_a_)), std::abs(robot_.jointRate(j_jaw_b_)));
     const bool reached = robot_.jointAngle(j_jaw_a_) < 0.02 && robot_.jointAngle(j_jaw_b_) < 0.02;
-    stall_time_ = moving < kStallRate ? stall_time_ + dt : 0.0;
-    if (reached || stall_time_ >= kStallTime) {
+    const bool stalled = stall_.update(moving, dt);
+    if (reached || stalled) {
       closing_ = false;
       // Probe at the tip with the front gripper's contact test.
       // The grip point: between the two jaws (else the tip link), probed like the front gripper's.

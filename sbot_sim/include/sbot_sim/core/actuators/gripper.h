@@ -64,6 +64,23 @@ bool probeStickable(World& world, const Robot& self, const Vec3& point, double r
 /// [rad/s], with at most `fmax` [N m]. Does nothing when the robot has no such hinge.
 void driveHinge(const Robot& robot, const std::string& joint, double target, double speed, double fmax);
 
+/// Jaws closing on an object stop short of their target: they count as stalled once their fastest
+/// joint has turned slower than kRate for kTime (the front gripper's jaws and the side arm's alike).
+class JawStall {
+ public:
+  static constexpr double kRate = 0.05;  ///< [rad/s]
+  static constexpr double kTime = 0.1;   ///< [s]
+  /// One step of `dt` [s] with the jaws turning at `rate` [rad/s]; true once stalled.
+  bool update(double rate, double dt) {
+    time_ = rate < kRate ? time_ + dt : 0.0;
+    return time_ >= kTime;
+  }
+  void reset() { time_ = 0; }
+
+ private:
+  double time_ = 0;  ///< [s] the jaws have been slower than kRate
+};
+
 class FrontGripper {
  public:
   enum class Type { None, Sticky, Jaws };
@@ -111,7 +128,7 @@ class FrontGripper {
   int cmd_elevation_ = 0;
   int cmd_aperture_ = 0;
   bool closing_ = false;       ///< a close command waits for the jaws (jaws) or the next update (sticky)
-  double stall_time_ = 0;      ///< [s] jaws not moving while closing
+  JawStall stall_;             ///< jaws not moving while closing
   double close_elapsed_ = 0, close_delay_ = 0;  ///< [s] since the close command; jaw travel time
   /// Jaws: once connected they hold the angles at which they closed on the ring [rad]; servoing on
   /// towards 0 would press them against a ring that the rigid connection holds, and the 5 g jaws

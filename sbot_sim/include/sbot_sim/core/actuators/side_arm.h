@@ -86,7 +86,8 @@ class SideArm {
   double t_qe_ = 0, t_ql_ = 0, t_qr_ = 0;  ///< servo targets [rad]
   int cmd_e_ = 0, cmd_r_ = 0, cmd_d_ = 60;
   bool closed_cmd_ = false, closing_ = false;
-  double stall_time_ = 0, force_lp_ = 0;
+  JawStall stall_;
+  double force_lp_ = 0;
 };
 
 }  // namespace actuators
