@@ -15,6 +15,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/output_files.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/scenario.h"
@@ -588,10 +589,8 @@ Dataset loadDatasetFields(const std::string& path_in) {
         b.pitch = o["pitch"] ? number(o["pitch"], f, field + ".pitch") : 0.0;
         b.surface = o["surface"] ? o["surface"].as<std::string>() : "wall";
         if (!surfaces.count(b.surface)) {
-          std::string list;
-          for (const auto& s : surfaces) list += (list.empty() ? "" : ", ") + s;
           fail(f, o["surface"] ? o["surface"] : o, field + ".surface",
-               "unknown surface '" + b.surface + "' (known: " + list + "; declare others under 'surfaces:')");
+               "unknown surface '" + b.surface + "' (known: " + nameList(surfaces) + "; declare others under 'surfaces:')");
         }
         ds.world.terrain.boxes.push_back(b);
       }

@@ -1,6 +1,7 @@
 #include "calibration/evaluation.h"
 
 #include "calibration/codec.h"
+#include "sbot_sim/core/errors.h"
 
 #include <algorithm>
 #include <cmath>
@@ -321,11 +322,6 @@ Dataset onlyRuns(const Dataset& ds, const std::set<std::string>& keep) {
   return out;
 }
 
-std::string joined(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
-  return out;
-}
 }  // namespace
 
 ReplayableRounds solveOnReplayableRuns(const Dataset& ds, const ModelSpec& start, const EvalOptions& opt,
@@ -364,7 +360,7 @@ ReplayableRounds solveOnReplayableRuns(const Dataset& ds, const ModelSpec& start
     std::vector<std::string> effects;
     for (const auto& e : solved.effects) effects.push_back(e.name);
     const std::string message =
-        "the model round " + std::to_string(out.round) + " ended with (" + (effects.empty() ? "no effect" : joined(effects)) +
+        "the model round " + std::to_string(out.round) + " ended with (" + (effects.empty() ? "no effect" : nameList(effects)) +
         ") reproduces " + std::to_string(readmit.size()) + " of the " + std::to_string(was_out.size()) +
         " runs left out (" + back.str() + "): re-admitted; round " + std::to_string(next.round) + " on " +
         std::to_string(next.dataset.runs.size()) + " runs, from the start model";
@@ -375,7 +371,7 @@ ReplayableRounds solveOnReplayableRuns(const Dataset& ds, const ModelSpec& start
     // (Letting such a round stand when its own model replays the runs it took back, tried 2026-11-29,
     // dropped a true latency on Fast for a spurious effect dropped elsewhere: docs/calibration.md.)
     if (const std::vector<std::string> lost = effectsLost(solved, next_solved); !lost.empty()) {
-      out.note = "round " + std::to_string(next.round) + " ended without " + joined(lost) + ", which round " +
+      out.note = "round " + std::to_string(next.round) + " ended without " + nameList(lost) + ", which round " +
                  std::to_string(out.round) + " found: the runs re-admitted are not reproducible away from its values, "
                  "so round " + std::to_string(out.round) + "'s result stands (on " +
                  std::to_string(out.dataset.runs.size()) + " runs)";

@@ -11,6 +11,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "sbot_sim/core/errors.h"
 #include "experiments.h"
 #include "yaml_file.h"
 
@@ -70,12 +71,6 @@ std::string alternatives(const std::string& accepts) {
 }
 
 bool contains(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
-
-std::string joined(const std::vector<std::string>& v) {
-  std::string s;
-  for (const std::string& x : v) s += (s.empty() ? "" : ", ") + x;
-  return s;
-}
 
 /// Reads the fields of one YAML map, refusing any it does not know (a misspelt field would
 /// otherwise be silently ignored).
@@ -145,7 +140,7 @@ class Fields {
   void noOthers() {
     for (const auto& kv : node_) {
       const std::string k = kv.first.as<std::string>("");
-      if (!known_.count(k)) fail_(where_ + ": unknown field '" + k + "' (fields: " + joined({known_.begin(), known_.end()}) + ")");
+      if (!known_.count(k)) fail_(where_ + ": unknown field '" + k + "' (fields: " + nameList(known_) + ")");
     }
   }
 
@@ -183,7 +178,7 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
   if (t.id.find_first_of(", \n") != std::string::npos)
     fail(at + ": an id may not hold a comma, space or line break (--only lists ids separated by commas)");
   if (contains(vocabulary.sections, t.id))
-    fail(at + ": '" + t.id + "' is the name of a built-in section (" + joined(vocabulary.sections) +
+    fail(at + ": '" + t.id + "' is the name of a built-in section (" + nameList(vocabulary.sections) +
          "); give the table another id");
   t.title = f.text("title", true);
   t.about = f.text("about", false);
@@ -219,7 +214,7 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
   t.after = f.list("after");
   for (const std::string& p : t.after)
     if (!contains(vocabulary.paragraphs, p))
-      fail(at + ": 'after' names '" + p + "', not a built-in paragraph (" + joined(vocabulary.paragraphs) + ")");
+      fail(at + ": 'after' names '" + p + "', not a built-in paragraph (" + nameList(vocabulary.paragraphs) + ")");
   if (!f.has("cells") || !f.node("cells").IsSequence() || f.node("cells").size() == 0)
     fail(at + ": 'cells' must be a non-empty list");
   std::set<std::string> keys;
@@ -255,7 +250,7 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
         fail(m.str());
       }
     }
-    if (!contains(vocabulary.levels, c.level)) fail(cat + ": level '" + c.level + "' is not one of " + joined(vocabulary.levels));
+    if (!contains(vocabulary.levels, c.level)) fail(cat + ": level '" + c.level + "' is not one of " + nameList(vocabulary.levels));
     for (std::size_t r = 0; r < t.references.size(); ++r) {
       const std::string& column = t.references[r];
       if (!cf.has(column)) fail(cat + ": missing the reference '" + column + "'");
@@ -279,7 +274,7 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
         for (std::string label; std::getline(ss, label, '|');)
           if (!contains(kind->labels, label))
             fail(cat + ": reference '" + column + "' accepts '" + label + "', which " + c.experiment +
-                 " never yields (its labels: " + joined(kind->labels) + ")");
+                 " never yields (its labels: " + nameList(kind->labels) + ")");
       } else {
         value.accepts.clear();
       }
@@ -336,7 +331,7 @@ ReferenceTables ReferenceTables::load(const std::string& path, const ReferenceVo
     if (e.has("section")) {
       entry.section = e.text("section", true);
       if (!contains(vocabulary.sections, entry.section))
-        fail(where + ": section '" + entry.section + "' is not a built-in section (" + joined(vocabulary.sections) + ")");
+        fail(where + ": section '" + entry.section + "' is not a built-in section (" + nameList(vocabulary.sections) + ")");
       for (const auto& [section, group] : vocabulary.section_groups)
         if (section == entry.section && !file.findGroup(group))
           fail(where + ": section '" + section + "' tallies its cells in group '" + group + "', which 'groups' does not define");

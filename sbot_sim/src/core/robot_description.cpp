@@ -391,9 +391,8 @@ void parseSidecar(RobotDescription& d) {
       const auto link = kv.first.as<std::string>();
       const std::string material = kv.second.IsScalar() ? kv.second.Scalar() : "";
       if (!robotMaterials().count(material)) {
-        std::string list;
-        for (const auto& r : robotMaterials()) list += (list.empty() ? "" : ", ") + r;
-        throw ConfigError(file, "materials." + link, "unknown material '" + material + "' (materials: " + list + ")");
+        throw ConfigError(file, "materials." + link,
+                          "unknown material '" + material + "' (materials: " + nameList(robotMaterials()) + ")");
       }
       bool found = false;
       for (auto& l : d.links) {

@@ -238,12 +238,9 @@ void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
   for (const auto& s : knownSurfaces()) names.insert(s);
   for (const auto& s : surfaceLabels(w.terrain)) names.insert(s);
   for (const auto& [material, mu] : w.contact.material_mu)
-    if (!names.count(material)) {
-      std::string list;
-      for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+    if (!names.count(material))
       throw ConfigError(file, "world.contact.materials." + material,
-                        "no robot material or terrain surface is called '" + material + "' (names: " + list + ")");
-    }
+                        "no robot material or terrain surface is called '" + material + "' (names: " + nameList(names) + ")");
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "sbot_sim/core/yaml_checks.h"
 
+#include "sbot_sim/core/errors.h"
+
 #include <map>
 #include <vector>
 
@@ -63,9 +65,7 @@ YAML::Node unknownKey(const YAML::Node& node, const std::set<std::string>& allow
 }
 
 std::string unknownFieldMessage(const std::set<std::string>& allowed) {
-  std::string list;
-  for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-  return "unknown field (expected one of: " + list + ")";
+  return "unknown field (expected one of: " + nameList(allowed) + ")";
 }
 
 }  // namespace sbot

@@ -20,6 +20,14 @@ class ConfigError : public std::runtime_error {
   std::string file_, field_;
 };
 
+/// "a, b, c": the names a message lists as what was expected (any range of strings, in its order).
+template <class Names>
+std::string nameList(const Names& names, const std::string& separator = ", ") {
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : separator) + n;
+  return list;
+}
+
 /// A request that names something that does not exist (unknown robot, link, level).
 class UnknownName : public std::invalid_argument {
  public:

@@ -135,10 +135,8 @@ void checkEffectSurfaces(const std::vector<EffectConfig>& configs, const std::st
     labels.insert(world_surfaces.begin(), world_surfaces.end());
     for (const auto& entry : c.params) {
       if (labels.count(entry.first)) continue;
-      std::string list;
-      for (const auto& l : labels) list += (list.empty() ? "" : ", ") + l;
       throw ConfigError(source, "effects[" + std::to_string(i) + "].params." + entry.first,
-                        c.name + ": unknown surface '" + entry.first + "' (known: " + list +
+                        c.name + ": unknown surface '" + entry.first + "' (known: " + nameList(labels) +
                             "; a dataset declares others under 'surfaces:', a scenario uses them on its boxes)");
     }
   }
