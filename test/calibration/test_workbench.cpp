@@ -119,7 +119,9 @@ TEST(ReplaySensitivity, NamesTheRunsEvenTheTrueModelCannotReproduce) {
   const Evaluation ev = evaluate(ds, truth, allRuns(ds), EvalOptions(), WorkerPool::global());
   for (const auto& rr : ev.runs) {
     const double rms = std::sqrt(rr.rss / std::max<std::size_t>(1, rr.n));
-    if (ds.runs[rr.run].name == "straight_20") EXPECT_LT(rms, 1.3);
+    if (ds.runs[rr.run].name == "straight_20") {
+      EXPECT_LT(rms, 1.3);
+    }
   }
   EXPECT_GT(ev.rmsNormalised(), 2.0) << "the chaotic arcs lift the true model's floor";
 }
