@@ -1,10 +1,15 @@
 // sbot_bench: how fast the headless core simulates swarms. Not a test: it prints figures.
 //
 //   sbot_bench [--level simple] [--robots 1,10,100] [--seconds 20] [--step 0.01] [--chains K] [--profile]
+//   sbot_bench --scenario FILE [--robots N,...] [--seconds 20] [--profile]
 //
 // --chains K: the robots form chains of K connected by static front-gripper links (robot i+1 grips
 // robot i; core/swarm/swarm_graph.h), each chain driving one random-walk command, and the swarm graph
 // (computeSwarmGraph, as /swarm/graph) is computed at 10 Hz; its cost is part of the timing.
+// --scenario FILE: your own world instead of the flat arena: the scenario's terrain, robots, static
+// links and effects (core/scenario_world.h, as the simulator node builds it), every robot on the same
+// random walk; --robots then overrides its swarm.count, one row per number. Its step and levels are
+// the scenario's (--level, --step and --chains are refused with it).
 // --profile: also print where the step time goes (World::enableProfile): solver, collision
 // detection, motor commands, feedback, and the contact joints per step.
 //
@@ -20,12 +25,14 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/scenario.h"  // kMaxRobots
+#include "sbot_sim/core/scenario_world.h"
 #include "sbot_sim/core/swarm/swarm_graph.h"
 #include "sbot_sim/core/world.h"
 #include "sbot_sim/tools/cli_args.h"
@@ -39,33 +46,50 @@ struct Options {
   double step = 0;  // 0: the level's recommended step
   int chains = 0;   // robots per chain, 0 = unconnected
   bool profile = false;
+  std::string scenario;  // a scenario file instead of the arena ("": the arena)
+  bool robots_given = false;
 };
+
+constexpr const char* kUsage =
+    "usage: sbot_bench [--level L] [--robots 1,10,100] [--seconds S] [--step DT] [--chains K] [--profile]\n"
+    "       sbot_bench --scenario FILE [--robots N,...] [--seconds S] [--profile]\n";
 
 Options parse(int argc, char** argv) {
   // Values are checked (atoi/atof turned "--robots 0" or "--seconds -1" into a row of nonsense).
   Options o;
+  bool arena_options = false;  // --level, --step or --chains: options of the arena only
   sbot_tools::ArgReader args("sbot_bench", argc, argv);
   while (args.more()) {
     const std::string a = args.option();
-    if (a == "--level") o.level = args.value();
+    arena_options = arena_options || a == "--level" || a == "--step" || a == "--chains";
+    if (a == "--scenario") o.scenario = args.value();
+    else if (a == "--level") o.level = args.value();
     else if (a == "--seconds") o.seconds = args.number(0.001, 1e6);
     else if (a == "--step") o.step = args.number(sbot::kMinStep, sbot::kMaxStep);
     else if (a == "--chains") o.chains = args.count(0, sbot::kMaxRobots);
     else if (a == "--profile") o.profile = true;
     else if (a == "--robots") {
+      o.robots_given = true;
       o.robots.clear();
       std::stringstream ss(args.value());
       for (std::string n; std::getline(ss, n, ',');)
         o.robots.push_back(sbot_tools::countArg("sbot_bench", "--robots", n, 1, sbot::kMaxRobots));
     } else {
-      std::fprintf(stderr, "usage: sbot_bench [--level L] [--robots 1,10,100] [--seconds S] [--step DT] [--chains K] [--profile]\n");
+      std::fprintf(stderr, "%s", kUsage);
       std::exit(a == "--help" ? 0 : 2);
     }
   }
+  if (!o.scenario.empty() && arena_options) {
+    std::fprintf(stderr, "sbot_bench: --level, --step and --chains set up the flat arena; with --scenario the scenario "
+                         "sets its levels, step and links\n%s", kUsage);
+    std::exit(2);
+  }
+  if (!o.scenario.empty() && !o.robots_given) o.robots = {-1};  // the scenario's own robots
   return o;
 }
 
-void runOne(const Options& o, int n) {
+/// The flat walled arena with `n` robots of --level on a grid, or in chains of --chains.
+std::unique_ptr<sbot::World> arenaWorld(const Options& o, int n) {
   const sbot::RobotDescription& d = sbot::loadLevel(o.level);
   sbot::WorldConfig c;
   c.step = o.step > 0 ? o.step : d.recommended_step;
@@ -84,7 +108,8 @@ void runOne(const Options& o, int n) {
     c.terrain.boxes.push_back({"wall", sbot::Vec3(ns ? 0 : (k == 2 ? o2 : -o2), ns ? (k == 0 ? o2 : -o2) : 0, 0.05),
                                ns ? sbot::Vec3(arena, 0.02, 0.1) : sbot::Vec3(0.02, arena, 0.1), 0, 0, "wall"});
   }
-  sbot::World w(c);
+  auto world = std::make_unique<sbot::World>(c);
+  sbot::World& w = *world;
   for (int i = 0; i < n; ++i) {
     if (o.chains > 0) {
       const int c = i / k, j = i % k;  // chain c, member j (j = 0 leads)
@@ -99,6 +124,30 @@ void runOne(const Options& o, int n) {
     w.addRobot(d, {(i % side - (side - 1) / 2.0) * spacing, (i / side - (side - 1) / 2.0) * spacing, 0.7 * i},
                "sbot_" + std::to_string(i));
   }
+  return world;
+}
+
+/// The level column of a row: the robots' level, or "mixed".
+std::string levelsOf(sbot::World& w) {
+  std::string level;
+  for (const sbot::Robot* r : w.robots()) {
+    const std::string l = r->description().level;
+    if (!level.empty() && l != level) return "mixed";
+    level = l;
+  }
+  return level;
+}
+
+/// One row: `n` robots (--scenario: its swarm.count overridden, or its own robots for n < 0) on a
+/// random walk for --seconds, in this process.
+void runOne(const Options& o, int n) {
+  const bool scenario = !o.scenario.empty();
+  std::unique_ptr<sbot::World> world =
+      scenario ? sbot::buildScenarioWorld(sbot::loadScenario(o.scenario, n)) : arenaWorld(o, n);
+  sbot::World& w = *world;
+  const sbot::WorldConfig& c = w.config();
+  const int k = std::max(1, o.chains);
+  const bool graph = o.chains > 0 || !w.connections().list().empty();
   const int graph_every = std::max(1, static_cast<int>(std::lround(0.1 / c.step)));  // 10 Hz
   std::size_t components = 0;
   const int steps = static_cast<int>(o.seconds / c.step);
@@ -118,12 +167,12 @@ void runOne(const Options& o, int n) {
       }
     }
     w.step();
-    if (o.chains > 0 && s % graph_every == 0) components = sbot::swarm::computeSwarmGraph(w).components;
+    if (graph && s % graph_every == 0) components = sbot::swarm::computeSwarmGraph(w).components;
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
-  std::printf("%-8s %7d %10.1f %12.1f %14.3f %12.1f", o.level.c_str(), n, w.time(), w.time() / wall,
+  std::printf("%-8s %7zu %10.1f %12.1f %14.3f %12.1f", levelsOf(w).c_str(), w.robotCount(), w.time(), w.time() / wall,
               1000.0 * wall / steps, ru.ru_maxrss / 1024.0);
   if (o.chains > 0) {
     // CPU-time RTM too: on a shared machine the wall clock includes waiting for a core.
@@ -144,8 +193,19 @@ void runOne(const Options& o, int n) {
 
 int main(int argc, char** argv) {
   const Options o = parse(argc, argv);
-  sbot_tools::requireLevel("sbot_bench", "--level", o.level);
-  std::printf("sbot_bench: headless core, flat arena, random walk, 1 core per run\n");
+  if (o.scenario.empty()) {
+    sbot_tools::requireLevel("sbot_bench", "--level", o.level);
+    std::printf("sbot_bench: headless core, flat arena, random walk, 1 core per run\n");
+  } else {
+    // Read here, before any row, so that a malformed file (or a count it cannot take) is refused once.
+    try {
+      for (int n : o.robots) sbot::loadScenario(o.scenario, n);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "sbot_bench: --scenario: %s\n", e.what());
+      return 2;
+    }
+    std::printf("sbot_bench: headless core, scenario %s, random walk, 1 core per run\n", o.scenario.c_str());
+  }
   std::printf("%-8s %7s %10s %12s %14s %12s\n", "level", "robots", "sim_s", "RTM", "wall_ms/step", "peak_MiB");
   std::fflush(stdout);
   int failures = 0;

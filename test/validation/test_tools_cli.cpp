@@ -70,6 +70,38 @@ TEST(ToolsCli, BenchRefusesWhatItCannotRun) {
   // A step of 1e-9 s sized per-robot buffers past the machine's memory; 0x10 read as 16.
   refused("--step 1e-9", "sbot_bench: --step expects a number in [0.0001, 0.5], found '1e-9'");
   refused("--seconds 0x10", "sbot_bench: --seconds expects a number in [0.001, 1e+06], found '0x10'");
+  refused("--scenario /nonexistent/s.yaml", "sbot_bench: --scenario: /nonexistent/s.yaml: cannot open scenario file");
+  refused("--scenario s.yaml --chains 2", "with --scenario the scenario sets its levels, step and links");
+}
+
+// --scenario: the row is the scenario's own world, robots and levels (not the arena's Simple s-bots),
+// and --robots overrides its swarm.count (the listed robots stay).
+TEST(ToolsCli, BenchRunsAScenarioFile) {
+  const std::string file = testing::TempDir() + "bench_scenario.yaml";
+  std::ofstream(file) << "world: {terrain: {type: plane, arena: {size: 2.0, height: 0.1}}}\n"
+                         "robots:\n"
+                         "  - {name: a, level: simple, pose: {x: 0, y: 0, yaw: 0}}\n"
+                         "  - {name: b, level: basic, pose: {x: 0.4, y: 0, yaw: 0}}\n"
+                         "swarm: {count: 4, level: simple, layout: grid, spacing: 0.3, center: [0, 0.5]}\n";
+  const auto row = [](const std::string& output) {  // the line after the column header
+    const std::size_t header = output.find("peak_MiB\n");
+    return header == std::string::npos ? std::string() : output.substr(header + 9, output.find('\n', header + 9) - header - 9);
+  };
+  const Outcome own = sbot_test::runProcess(std::string(SBOT_BENCH_BIN) + " --scenario " + file + " --seconds 0.2");
+  ASSERT_EQ(own.status, 0) << own.output;
+  std::istringstream r(row(own.output));
+  std::string level;
+  int robots = 0;
+  double sim_s = 0;
+  r >> level >> robots >> sim_s;
+  EXPECT_EQ(level, "mixed") << own.output;
+  EXPECT_EQ(robots, 6) << own.output;  // two explicit, four of the swarm block
+  EXPECT_NEAR(sim_s, 0.2, 0.011) << own.output;
+  const Outcome fewer = sbot_test::runProcess(std::string(SBOT_BENCH_BIN) + " --scenario " + file + " --robots 1 --seconds 0.1");
+  ASSERT_EQ(fewer.status, 0) << fewer.output;
+  std::istringstream f(row(fewer.output));
+  f >> level >> robots;
+  EXPECT_EQ(robots, 3) << fewer.output;  // the two listed and one of the swarm block
 }
 
 // The last option without its value (two_sbots used to read it as "": --level "" then failed later

@@ -3,7 +3,7 @@
 #include "publication_stamps.h"
 #include "robot_lookup.h"
 
-#include "sbot_sim/core/effects/effects_file.h"
+#include "sbot_sim/core/scenario_world.h"
 
 #include <algorithm>
 #include <cmath>
@@ -205,20 +205,12 @@ bool SimRosInterface::init() {
 }
 
 std::unique_ptr<sbot::World> SimRosInterface::buildWorld() const {
-  auto world = std::make_unique<sbot::World>(scenario_.world);
-  for (const sbot::RobotSpawn& s : scenario_.robots)
-    world->addRobot(sbot::loadLevel(s.level), s.pose, s.name);
-  if (const std::string overlap = world->robotsOverlapProblem(); !overlap.empty())
-    throw sbot::ConfigError(params_.scenario, "robots", overlap);
-  sbot::swarm::addScenarioLinks(*world, scenario_.links);  // static links (seed 2.2.3)
+  std::unique_ptr<sbot::World> world = sbot::buildScenarioWorld(scenario_);
   if (!scenario_.effects_file.empty()) {
-    // The calibration workbench's effects file: throws ConfigError naming file and field.
-    std::string names;
-    for (const sbot::EffectPtr& e : sbot::loadEffectsFile(scenario_.effects_file, sbot::surfaceLabels(scenario_.world.terrain))) {
-      world->addEffect(e);
-      names += (names.empty() ? "" : ", ") + e->name();
-    }
-    ROS_INFO("simulator: effects from %s: %s", scenario_.effects_file.c_str(), names.empty() ? "none" : names.c_str());
+    std::vector<std::string> names;
+    for (const sbot::EffectPtr& e : world->effects()) names.push_back(e->name());
+    ROS_INFO("simulator: effects from %s: %s", scenario_.effects_file.c_str(),
+             names.empty() ? "none" : sbot::nameList(names).c_str());
   }
   return world;
 }
