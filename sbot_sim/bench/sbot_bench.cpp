@@ -127,12 +127,12 @@ std::unique_ptr<sbot::World> arenaWorld(const Options& o, int n) {
   return world;
 }
 
-/// The level column of a row: the robots' level, or "mixed".
+/// The level column of a row: the robots' level, "mixed", or "none" for a scenario without robots.
 std::string levelsOf(sbot::World& w) {
-  std::string level;
+  std::string level = "none";
   for (const sbot::Robot* r : w.robots()) {
     const std::string l = r->description().level;
-    if (!level.empty() && l != level) return "mixed";
+    if (level != "none" && l != level) return "mixed";
     level = l;
   }
   return level;
