@@ -241,20 +241,26 @@ std::size_t Dataset::sampleCount() const {
   return n;
 }
 
-Dataset withoutRuns(const Dataset& ds, const std::set<std::string>& skip) {
-  std::set<std::string> missing = skip;
+Dataset onlyRuns(const Dataset& ds, const std::set<std::string>& keep) {
   Dataset kept = ds;
   kept.runs.clear();
+  for (const Run& r : ds.runs)
+    if (keep.count(r.name)) kept.runs.push_back(r);
+  return kept;
+}
+
+Dataset withoutRuns(const Dataset& ds, const std::set<std::string>& skip) {
+  std::set<std::string> missing = skip, keep;
+  std::vector<std::string> known;
   for (const Run& r : ds.runs) {
     missing.erase(r.name);
-    if (!skip.count(r.name)) kept.runs.push_back(r);
+    known.push_back(r.name);
+    if (!skip.count(r.name)) keep.insert(r.name);
   }
-  if (!missing.empty()) {
-    std::string names, known;
-    for (const auto& n : missing) names += (names.empty() ? "" : ", ") + n;
-    for (const Run& r : ds.runs) known += (known.empty() ? "" : ", ") + r.name;
-    throw std::invalid_argument("dataset " + ds.name + " has no run named " + names + " (its runs: " + known + ")");
-  }
+  if (!missing.empty())
+    throw std::invalid_argument("dataset " + ds.name + " has no run named " + nameList(missing) + " (its runs: " +
+                                nameList(known) + ")");
+  Dataset kept = onlyRuns(ds, keep);
   if (kept.runs.empty())
     throw std::invalid_argument("leaving out " + std::to_string(skip.size()) + " run(s) leaves dataset " + ds.name +
                                 " with no run");

@@ -133,6 +133,8 @@ Dataset loadDataset(const std::string& path);
 /// Parse one run file (exposed for tests).
 void parseRunCsv(const std::string& text, const std::string& file, Run& run);
 
+/// `ds` with only the runs named in `keep`, in dataset order (names it does not have are ignored).
+Dataset onlyRuns(const Dataset& ds, const std::set<std::string>& keep);
 /// The dataset without the runs named in `skip` (e.g. runs a model cannot replay, evaluation.h
 /// ReplaySensitivity). Throws std::invalid_argument naming a run the dataset does not have, or when
 /// no run would be left.

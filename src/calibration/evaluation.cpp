@@ -313,15 +313,6 @@ std::vector<std::string> effectsLost(const ModelSpec& before, const ModelSpec& a
   return lost;
 }
 
-/// `ds` with only the runs named in `keep`, in dataset order.
-Dataset onlyRuns(const Dataset& ds, const std::set<std::string>& keep) {
-  Dataset out = ds;
-  out.runs.clear();
-  for (const auto& r : ds.runs)
-    if (keep.count(r.name)) out.runs.push_back(r);
-  return out;
-}
-
 }  // namespace
 
 ReplayableRounds solveOnReplayableRuns(const Dataset& ds, const ModelSpec& start, const EvalOptions& opt,
