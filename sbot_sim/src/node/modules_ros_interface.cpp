@@ -20,6 +20,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "ros_conversions.h"
+#include "sbot_sim/core/errors.h"
 #include "sbot_sim/ros/typed_param.h"
 
 namespace sbot_node {
@@ -49,6 +50,16 @@ const std::vector<std::pair<std::string, double>>& channelDefaults() {
       {"camera", 10},    {"gripper", 10}, {"side_arm", 10}, {"battery", 1}, {"climate", 1}, {"leds", 10},
       {"markers", 10}, {"raw_camera", 5}};
   return d;
+}
+
+/// The rate channels' names, in channelDefaults' order (for messages and look-ups).
+const std::vector<std::string>& channelNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const auto& [ch, def] : channelDefaults()) n.push_back(ch);
+    return n;
+  }();
+  return names;
 }
 
 std::string clampNote(const char* what, long asked, long applied, long lo, long hi) {
@@ -631,9 +642,7 @@ bool RobotModulesRos::onSetSamplingRate(sbot_msgs::SetSamplingRate::Request& req
   }
   auto it = rates_.find(req.channel);
   if (it == rates_.end()) {
-    std::string list;
-    for (const auto& [ch, r] : rates_) list += (list.empty() ? "" : ", ") + ch;
-    res.message = "unknown channel '" + req.channel + "' (channels: " + list + ")";
+    res.message = "unknown channel '" + req.channel + "' (channels: " + sbot::nameList(channelNames()) + ")";
     return true;
   }
   double hz = 0;
@@ -676,16 +685,15 @@ bool ModulesRosInterface::checkRateParams(const ros::NodeHandle& pnh) {
   if (!pnh.hasParam("rates")) return true;
   XmlRpc::XmlRpcValue rates;
   pnh.getParam("rates", rates);
-  std::string known;
-  for (const auto& [ch, def] : channelDefaults()) known += (known.empty() ? "" : ", ") + ch;
+  const std::vector<std::string>& channels = channelNames();
+  const std::string known = sbot::nameList(channels);
   if (rates.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
     ROS_FATAL("simulator: ~rates must be a map of channel: Hz (channels: %s)", known.c_str());
     return false;
   }
   bool ok = true;
   for (auto it = rates.begin(); it != rates.end(); ++it) {
-    const auto& defaults = channelDefaults();
-    if (std::none_of(defaults.begin(), defaults.end(), [&](const auto& c) { return c.first == it->first; })) {
+    if (std::find(channels.begin(), channels.end(), it->first) == channels.end()) {
       ROS_FATAL("simulator: ~rates/%s: unknown channel (channels: %s)", it->first.c_str(), known.c_str());
       ok = false;
       continue;
