@@ -424,7 +424,6 @@ void parseSidecar(RobotDescription& d) {
       if (kv.second.IsScalar()) d.extra[kv.first.as<std::string>()] = kv.second.as<std::string>();
     }
     d.solver_iterations = get<int>(e, "solver_iterations", 0, file, "extra.");
-    if (d.solver_iterations < 0) throw ConfigError(file, "extra.solver_iterations", "must be >= 0");
   }
   d.sidecar = root;
 }

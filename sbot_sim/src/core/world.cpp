@@ -547,7 +547,7 @@ std::string World::robotsOverlapProblem() const {
     if (o.depth <= kPlacementTolerance) continue;
     std::ostringstream why;
     why << "robot '" << r->name() << "' and " << o.with << " overlap by " << std::fixed << std::setprecision(3)
-        << o.depth << " m at their start poses (at most " << kPlacementTolerance << " m; a robot is 0.116 m across)";
+        << o.depth << " m at their start poses (at most " << kPlacementTolerance << " m)";
     return why.str();
   }
   return "";
