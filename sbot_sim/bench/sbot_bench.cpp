@@ -222,6 +222,10 @@ int main(int argc, char** argv) {
     }
     int status = 0;
     waitpid(pid, &status, 0);
+    // A run that dies (ODE aborts on an internal error) must not leave its row silently missing.
+    if (WIFSIGNALED(status))
+      std::fprintf(stderr, "sbot_bench: the run with %d robots was killed by signal %d (%s); no row for it\n", n,
+                   WTERMSIG(status), strsignal(WTERMSIG(status)));
     failures += !(WIFEXITED(status) && WEXITSTATUS(status) == 0);
   }
   return failures == 0 ? 0 : 1;

@@ -130,7 +130,7 @@ bool parseNumber(const std::string& cell, double& out) {
   out = std::strtod(b, &e);
   // strtod also reads hexadecimal ("0x10" = 16), which no measurement file means.
   if (cell.find_first_of("xX") != std::string::npos) return false;
-  return e != b && *e == '\0';
+  return e != b && e == b + cell.size();  // the whole cell: not up to a NUL byte inside it
 }
 
 }  // namespace
@@ -435,6 +435,9 @@ void parseRunCsv(const std::string& text, const std::string& file, Run& run) {
         for (auto [c, v] : {std::pair<const char*, double>{"cmd_left", l}, {"cmd_right", r}})
           if (std::abs(v) > 127)
             throw DatasetError(file, line_no, col.at(c) + 1, c, "command outside the API range [-127, 127]");
+          else if (v != std::round(v))
+            throw DatasetError(file, line_no, col.at(c) + 1, c,
+                               "command " + fmtNumber(v) + " is not a whole number of API units (setSpeed takes integers)");
         run.cmd_t.push_back(t);
         run.cmd_left.push_back(l);
         run.cmd_right.push_back(r);

@@ -161,10 +161,12 @@ NumberFormat readFormat(const YAML::Node& node, const std::string& where, const 
   n.scale = f.number("scale", false, 1);
   if (!(n.scale > 0 && n.scale <= 1e6))
     fail(where + ": scale expects a number in (0, 1e6], found '" + f.text("scale", false) + "'");
-  const double decimals = f.number("decimals", false, -1);
-  if (decimals != -1 && (decimals != std::round(decimals) || decimals < 0 || decimals > 6))
-    fail(where + ": decimals expects a whole number from 0 to 6, found '" + f.text("decimals", false) + "'");
-  n.decimals = static_cast<int>(decimals);
+  if (f.has("decimals")) {  // absent: -1, the value as written (not a value a file may give)
+    const double decimals = f.number("decimals", true);
+    if (decimals != std::round(decimals) || decimals < 0 || decimals > 6)
+      fail(where + ": decimals expects a whole number from 0 to 6, found '" + f.text("decimals", false) + "'");
+    n.decimals = static_cast<int>(decimals);
+  }
   f.noOthers();
   return n;
 }
@@ -198,6 +200,9 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
   if (f.has("param")) t.param = readFormat(f.node("param"), at + ", param", t.param.header, fail);
   t.references = f.list("references");
   if (t.references.empty()) fail(at + ": 'references' must name at least one column (the first is compared)");
+  for (std::size_t i = 0; i < t.references.size(); ++i)
+    for (std::size_t k = 0; k < i; ++k)
+      if (t.references[i] == t.references[k]) fail(at + ": 'references' names the column '" + t.references[i] + "' twice");
   for (const std::string& column : t.references)  // a cell's own fields cannot also be its columns
     for (const char* field : {"param", "experiment", "level", "variant", "speed_units", "track_mu"})
       if (column == field) fail(at + ": the reference column '" + column + "' has the name of a cell's field; rename it");

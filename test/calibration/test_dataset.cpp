@@ -149,6 +149,14 @@ TEST(Dataset, NaNAndGarbageCells) {
   EXPECT_EQ(e.column(), 4);
   e = errorOf(makeDataset("range", "t,cmd_left,cmd_right,x\n0,200,1,0\n"));
   EXPECT_EQ(e.columnName(), "cmd_left");
+  // Read as 20 and as 20.5 before (an outside probe, 2026-11-29): a NUL byte inside a cell, and a
+  // command between API units, which setSpeed cannot have been given.
+  e = errorOf(makeDataset("nul", std::string("t,cmd_left,cmd_right,x\n0,20\0,1,0\n", 33)));
+  EXPECT_EQ(e.line(), 2);
+  EXPECT_EQ(e.columnName(), "cmd_left");
+  e = errorOf(makeDataset("halfunit", "t,cmd_left,cmd_right,x\n0,20.5,1,0\n"));
+  EXPECT_EQ(e.columnName(), "cmd_left");
+  EXPECT_NE(std::string(e.what()).find("command 20.5 is not a whole number of API units"), std::string::npos) << e.what();
 }
 
 TEST(Dataset, UnknownSurfaceNamesTheYamlLine) {

@@ -194,6 +194,9 @@ TEST(ReferenceTables, MalformedFilesAreRefusedWithTheEntryAndTheProblem) {
         "cell 2: field 'track_mu' expects a friction coefficient in [1e-6, 100] or lab_floor, found '-0.5'"},
       {with("level: medium\n", "level: medium\n      track_mu: lab floor\n"), "found 'lab floor'"},
       {with("decimals: 1}", "decimals: 9}"), "table 'lab1', value: decimals expects a whole number from 0 to 6, found '9'"},
+      // -1 is how the loader marks "not given"; written in a file it was taken as that (2026-11-29).
+      {with("decimals: 1}", "decimals: -1}"), "table 'lab1', value: decimals expects a whole number from 0 to 6, found '-1'"},
+      {with("references: [measured]", "references: [measured, measured]"), "'references' names the column 'measured' twice"},
       {with("required: true", "required: maybe"), "field 'required' expects true or false, found 'maybe'"},
       {with("report:\n", "report:\n  - section: rtm\n"), "section 'rtm' is not a built-in section"},
       {with("report:\n", "report:\n  - section: 4.1pair\n"), "tallies its cells in group 'hardware', which 'groups' does not define"},

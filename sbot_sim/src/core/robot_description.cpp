@@ -4,15 +4,18 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <set>
 #include <sstream>
 
+#include <Eigen/Cholesky>
 #include <urdf_parser/urdf_parser.h>
 #include <yaml-cpp/yaml.h>
 
 #include "sbot_sim/core/yaml_checks.h"
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/world_config.h"
 
 #ifndef SBOT_DESCRIPTION_SOURCE_DIR
 #define SBOT_DESCRIPTION_SOURCE_DIR ""
@@ -67,9 +70,26 @@ std::size_t countTags(const std::string& xml, const std::string& tag) {
 }
 
 constexpr double kMaxTorqueWindow = 10;  ///< [s] treels.torque_window
+// Bounds on a description's numbers: far beyond any s-bot (12 cm, 0.66 kg), yet finite values past
+// them (1e300) overflow ODE's normalisations, which abort the process instead of reporting.
+constexpr double kMaxLength = 100;     ///< [m] offsets and shape sizes
+constexpr double kMaxMass = 1000;      ///< [kg] per link
+constexpr double kMaxInertia = 1000;   ///< [kg m^2] per inertia entry
 
 void requirePositive(double v, const std::string& file, const std::string& field) {
   if (!(std::isfinite(v) && v > 0)) throw ConfigError(file, field, "must be a finite number > 0");
+}
+
+void requireAtMost(double v, double limit, const std::string& file, const std::string& field, const char* unit) {
+  if (!(std::abs(v) <= limit)) {
+    std::ostringstream why;
+    why << "must be at most " << limit << " " << unit << " in size, found " << v;
+    throw ConfigError(file, field, why.str());
+  }
+}
+
+void requireReasonableOrigin(const Pose& origin, const std::string& file, const std::string& field) {
+  for (int k = 0; k < 3; ++k) requireAtMost(origin.position[k], kMaxLength, file, field + " xyz", "m");
 }
 
 LinkDescription convertLink(const urdf::Link& link, const std::string& xml, const std::string& file) {
@@ -90,14 +110,22 @@ LinkDescription convertLink(const urdf::Link& link, const std::string& xml, cons
     const urdf::Inertial& in = *link.inertial;
     if (!(std::isfinite(in.mass) && in.mass >= 0))
       throw ConfigError(file, "link " + link.name + "/inertial/mass", "must be a finite number >= 0");
+    requireAtMost(in.mass, kMaxMass, file, "link " + link.name + "/inertial/mass", "kg");
     out.mass = in.mass;
     out.inertial_origin = toPose(in.origin);
+    requireReasonableOrigin(out.inertial_origin, file, "link " + link.name + "/inertial/origin");
     out.inertia << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
-    if (!out.inertia.allFinite())
-      throw ConfigError(file, "link " + link.name + "/inertial/inertia", "must be finite");
+    const std::string field = "link " + link.name + "/inertial/inertia";
+    if (!out.inertia.allFinite()) throw ConfigError(file, field, "must be finite");
+    for (int k = 0; k < 9; ++k) requireAtMost(out.inertia(k / 3, k % 3), kMaxInertia, file, field, "kg m^2");
     if (in.mass > 0 && (in.ixx <= 0 || in.iyy <= 0 || in.izz <= 0)) {
-      throw ConfigError(file, "link " + link.name + "/inertial/inertia",
-                        "diagonal inertia must be positive for a link with mass");
+      throw ConfigError(file, field, "diagonal inertia must be positive for a link with mass");
+    }
+    // ODE refuses (aborts on) an inertia tensor that is not positive definite: products of inertia
+    // too large for the moments.
+    if (in.mass > 0 && Eigen::LLT<Mat3>(out.inertia).info() != Eigen::Success) {
+      throw ConfigError(file, field,
+                        "must be positive definite (ixy, ixz, iyz too large for ixx, iyy, izz); a rigid body's is");
     }
   }
   for (const auto& col : link.collision_array) {
@@ -106,11 +134,13 @@ LinkDescription convertLink(const urdf::Link& link, const std::string& xml, cons
     const std::string field = "link " + link.name + "/collision/geometry";
     CollisionShape shape;
     shape.origin = toPose(col->origin);
+    requireReasonableOrigin(shape.origin, file, "link " + link.name + "/collision/origin");
     switch (col->geometry->type) {
       case urdf::Geometry::SPHERE:
         shape.type = CollisionShape::Type::Sphere;
         shape.radius = static_cast<const urdf::Sphere&>(*col->geometry).radius;
         requirePositive(shape.radius, file, field + "/sphere radius");
+        requireAtMost(shape.radius, kMaxLength, file, field + "/sphere radius", "m");
         break;
       case urdf::Geometry::CYLINDER: {
         const auto& c = static_cast<const urdf::Cylinder&>(*col->geometry);
@@ -119,6 +149,7 @@ LinkDescription convertLink(const urdf::Link& link, const std::string& xml, cons
         shape.length = c.length;
         requirePositive(shape.radius, file, field + "/cylinder radius");
         requirePositive(shape.length, file, field + "/cylinder length");
+        requireAtMost(std::max(shape.radius, shape.length), kMaxLength, file, field + "/cylinder", "m");
         break;
       }
       case urdf::Geometry::BOX: {
@@ -126,6 +157,7 @@ LinkDescription convertLink(const urdf::Link& link, const std::string& xml, cons
         shape.type = CollisionShape::Type::Box;
         shape.size = Vec3(b.dim.x, b.dim.y, b.dim.z);
         for (int k = 0; k < 3; ++k) requirePositive(shape.size[k], file, field + "/box size");
+        for (int k = 0; k < 3; ++k) requireAtMost(shape.size[k], kMaxLength, file, field + "/box size", "m");
         break;
       }
       default:
@@ -143,6 +175,7 @@ JointDescription convertJoint(const urdf::Joint& j, const std::string& file) {
   out.parent = j.parent_link_name;
   out.child = j.child_link_name;
   out.origin = toPose(j.parent_to_joint_origin_transform);
+  requireReasonableOrigin(out.origin, file, "joint " + j.name + "/origin");
   out.axis = Vec3(j.axis.x, j.axis.y, j.axis.z);
   switch (j.type) {
     case urdf::Joint::FIXED: out.type = JointDescription::Type::Fixed; break;
@@ -284,6 +317,63 @@ T get(const YAML::Node& node, const std::string& key, const T& fallback, const s
   }
 }
 
+/// The side arm's section (Detailed): the names it gives must be the URDF's, and the loop joints'
+/// anchors and axes finite 3-vectors (a NaN anchor or a zero axis aborts inside ODE).
+static void checkSideArm(const YAML::Node& arm, const RobotDescription& d, const std::string& file) {
+  const auto text = [&](const YAML::Node& n, const std::string& field) {
+    if (!n.IsScalar()) throw ConfigError(file, field, "expected a name");
+    return n.Scalar();
+  };
+  const auto link = [&](const YAML::Node& n, const std::string& field) {
+    const std::string name = text(n, field);
+    if (!d.findLink(name)) throw ConfigError(file, field, "no link '" + name + "' in " + d.urdf_path);
+  };
+  const auto joint = [&](const YAML::Node& n, const std::string& field) {
+    const std::string name = text(n, field);
+    if (!d.findJoint(name)) throw ConfigError(file, field, "no joint '" + name + "' in " + d.urdf_path);
+  };
+  for (const char* key : {"base_link", "tip_link"})
+    if (arm[key]) link(arm[key], std::string("side_arm.") + key);
+  if (const YAML::Node servos = arm["servos"]) {
+    if (!servos.IsMap()) throw ConfigError(file, "side_arm.servos", "expected a mapping of servo names to joints");
+    for (const auto& kv : servos) joint(kv.second, "side_arm.servos." + kv.first.Scalar());
+  }
+  if (const YAML::Node passive = arm["passive_joints"]) {
+    if (!passive.IsSequence()) throw ConfigError(file, "side_arm.passive_joints", "expected a list of joints");
+    for (std::size_t i = 0; i < passive.size(); ++i) joint(passive[i], "side_arm.passive_joints[" + std::to_string(i) + "]");
+  }
+  if (const YAML::Node loops = arm["loop_joints"]) {
+    if (!loops.IsSequence()) throw ConfigError(file, "side_arm.loop_joints", "expected a list of {name, parent, child, ...}");
+    for (std::size_t i = 0; i < loops.size(); ++i) {
+      const std::string at = "side_arm.loop_joints[" + std::to_string(i) + "]";
+      const YAML::Node lj = loops[i];
+      if (!lj.IsMap()) throw ConfigError(file, at, "expected a mapping {name, parent, child, anchor_in_parent, axis}");
+      for (const char* key : {"parent", "child"}) {
+        if (!lj[key]) throw ConfigError(file, at + "." + key, "missing");
+        link(lj[key], at + "." + key);
+      }
+      for (const char* key : {"anchor_in_parent", "anchor_in_child", "axis"}) {
+        if (!lj[key]) continue;
+        const std::string field = at + "." + key;
+        const YAML::Node v = lj[key];
+        Vec3 x;
+        try {
+          if (!v.IsSequence() || v.size() != 3) throw YAML::Exception(YAML::Mark::null_mark(), "");
+          x = Vec3(v[0].as<double>(), v[1].as<double>(), v[2].as<double>());
+        } catch (const YAML::Exception&) {
+          throw ConfigError(file, field, "expected [x, y, z], three numbers");
+        }
+        if (!x.allFinite()) throw ConfigError(file, field, "must be finite");
+        for (int k = 0; k < 3; ++k) requireAtMost(x[k], kMaxLength, file, field, "m");
+        if (std::string(key) == "axis" && x.norm() < 1e-9) throw ConfigError(file, field, "zero axis");
+      }
+    }
+  }
+  // Divisors of the arm's kinematics (SideArm): a zero turns its limits into infinities.
+  for (const char* key : {"unit", "link_length", "rhombi"})
+    if (arm[key]) requirePositive(get<double>(arm, key, 1.0, file, "side_arm."), file, std::string("side_arm.") + key);
+}
+
 void parseSidecar(RobotDescription& d) {
   const std::string& file = d.sidecar_path;
   YAML::Node root;
@@ -299,6 +389,45 @@ void parseSidecar(RobotDescription& d) {
   const std::set<std::string> sections{"level",     "recommended_step", "gravity", "treels", "turret",
                                        "materials", "extra",            "gripper", "side_arm"};
   if (const YAML::Node key = unknownKey(root, sections)) throw ConfigError(file, key.Scalar(), unknownFieldMessage(sections));
+  for (const char* section : {"treels", "turret", "materials", "extra", "gripper", "side_arm"})
+    if (root[section] && !root[section].IsMap()) throw ConfigError(file, section, "expected a mapping");
+  // The fields of each section (sbot_description/README.md; generate_urdf.py writes them): a
+  // misspelt field would otherwise leave its default in force unseen. The second set: numbers that
+  // no later check reads here (the modules read them when they are built), checked finite now.
+  const std::map<std::string, std::pair<std::set<std::string>, std::set<std::string>>> fields{
+      {"treels",
+       {{"left_joints", "right_joints", "wheel_radii", "friction_law", "drive", "wheel_radius", "max_torque",
+         "torque_unit", "speed_unit", "speed_limit_units", "gear_ratio", "rotor_inertia", "backdrive_force",
+         "torque_window", "creep_stiffness", "friction_scale", "friction_force_limit"},
+        {"max_speed", "wheel_effort"}}},
+      {"turret", {{"joint", "speed", "unit", "range_units", "max_torque", "torque_unit"}, {}}},
+      {"gripper",
+       {{"type", "link", "tip_frame", "elevation_joint", "jaw_joints"},
+        {"grip_point", "aperture_max", "elevation_lower", "elevation_upper", "elevation_speed", "elevation_torque",
+         "jaw_force", "jaw_length", "jaw_speed", "jaw_torque", "zero_set_point"}}},
+      {"side_arm",
+       {{"base_link", "tip_link", "servos", "passive_joints", "loop_joints", "kinematics"},
+        {"rest_azimuth", "link_length", "rhombi", "rest_half_angle", "half_angle_min", "half_angle_max",
+         "rotation_range", "depth_rest", "unit", "elevation_torque", "horizontal_torque", "servo_speed", "jaw_force",
+         "jaw_speed", "jaw_torque", "aperture_max"}}}};
+  for (const auto& [section, kinds] : fields) {
+    const YAML::Node n = root[section];
+    if (!n) continue;
+    std::set<std::string> known = kinds.first;
+    known.insert(kinds.second.begin(), kinds.second.end());
+    if (const YAML::Node key = unknownKey(n, known))
+      throw ConfigError(file, section + "." + key.Scalar(), unknownFieldMessage(known));
+    for (const std::string& key : kinds.second) {
+      if (!n[key]) continue;
+      double v = 0;
+      try {
+        v = n[key].as<double>();
+      } catch (const YAML::Exception&) {
+        throw ConfigError(file, section + "." + key, "expected a number");
+      }
+      if (!std::isfinite(v)) throw ConfigError(file, section + "." + key, "must be finite");
+    }
+  }
   d.level = get<std::string>(root, "level", "", file, "");
   if (d.level.empty()) throw ConfigError(file, "level", "missing");
   d.recommended_step = get<double>(root, "recommended_step", 0.01, file, "");
@@ -326,8 +455,14 @@ void parseSidecar(RobotDescription& d) {
   const auto nonNegative = [&](double v, const std::string& field) {
     if (!(std::isfinite(v) && v >= 0)) throw ConfigError(file, field, "must be a finite number >= 0");
   };
-  requirePositive(d.recommended_step, file, "recommended_step");
+  if (!(d.recommended_step >= kMinStep && d.recommended_step <= kMaxStep)) {
+    std::ostringstream why;
+    why << "expected a step in [" << kMinStep << ", " << kMaxStep << "] s (as a scenario's world.step), found "
+        << d.recommended_step;
+    throw ConfigError(file, "recommended_step", why.str());
+  }
   nonNegative(d.gravity, "gravity");
+  requireAtMost(d.gravity, kMaxGravity, file, "gravity", "m/s^2");
   requirePositive(tr.max_torque, file, "treels.max_torque");
   requirePositive(tr.torque_unit, file, "treels.torque_unit");
   requirePositive(tr.speed_unit, file, "treels.speed_unit");
@@ -355,14 +490,22 @@ void parseSidecar(RobotDescription& d) {
   if (tr.left_joints.empty() || tr.right_joints.empty())
     throw ConfigError(file, "treels.left_joints/right_joints", "each track needs at least one driven joint");
   requirePositive(tr.wheel_radius, file, "treels.wheel_radius");
+  std::set<std::string> driven;  // one joint, one track, once
   for (const auto& side : {tr.left_joints, tr.right_joints}) {
     for (const auto& name : side) {
       const JointDescription* j = d.findJoint(name);
       if (!j) throw ConfigError(file, "treels", "driven joint '" + name + "' is not in " + d.urdf_path);
       if (j->type != JointDescription::Type::Continuous && j->type != JointDescription::Type::Revolute)
         throw ConfigError(file, "treels", "driven joint '" + name + "' must be continuous, found fixed");
+      if (!driven.insert(name).second)
+        throw ConfigError(file, "treels.left_joints/right_joints",
+                          "driven joint '" + name + "' is listed twice (each joint drives one track, once)");
     }
   }
+  for (const auto& r : tr.wheel_radii)
+    if (!driven.count(r.first))
+      throw ConfigError(file, "treels.wheel_radii." + r.first,
+                        "not a driven joint (driven joints: " + nameList(driven) + ")");
 
   if (const YAML::Node tu = root["turret"]) {
     auto& tt = d.turret;
@@ -372,8 +515,12 @@ void parseSidecar(RobotDescription& d) {
     tt.range_units = get<int>(tu, "range_units", tt.range_units, file, "turret.");
     tt.max_torque = get<double>(tu, "max_torque", tt.max_torque, file, "turret.");
     tt.torque_unit = get<double>(tu, "torque_unit", tt.torque_unit, file, "turret.");
-    if (!tt.joint.empty() && !d.findJoint(tt.joint))
+    const JointDescription* tj = tt.joint.empty() ? nullptr : d.findJoint(tt.joint);
+    if (!tt.joint.empty() && !tj)
       throw ConfigError(file, "turret.joint", "joint '" + tt.joint + "' is not in " + d.urdf_path);
+    if (tj && tj->type == JointDescription::Type::Fixed)
+      throw ConfigError(file, "turret.joint", "joint '" + tt.joint + "' must be revolute or continuous, found fixed in " +
+                                                  d.urdf_path);
     for (const auto& side : {tr.left_joints, tr.right_joints})
       for (const auto& name : side)
         if (name == tt.joint) throw ConfigError(file, "turret.joint", "'" + name + "' is a driven treels joint");
@@ -417,6 +564,7 @@ void parseSidecar(RobotDescription& d) {
     for (const auto& j : get<std::vector<std::string>>(g, "jaw_joints", {}, file, "gripper."))
       if (!d.findJoint(j)) throw ConfigError(file, "gripper.jaw_joints", "no joint '" + j + "' in " + d.urdf_path);
   }
+  if (const YAML::Node arm = root["side_arm"]) checkSideArm(arm, d, file);
   // Everything else that is a scalar is kept as text for the modules that need it.
   if (const YAML::Node e = root["extra"]) {
     checkExtra(e, file);

@@ -19,7 +19,6 @@ namespace {
 
 /// Seeds are whole numbers a double holds exactly.
 constexpr long long kMaxSeed = 1LL << 53;
-constexpr double kMaxGravity = 1000;  // [m/s^2]
 
 // Reads typed fields of one YAML mapping and reports errors with the full dotted field path.
 class Fields {
@@ -145,6 +144,9 @@ void parseTerrain(const YAML::Node& n, TerrainConfig& t, const std::string& file
   else if (type == "composite") t.type = TerrainConfig::Type::Composite;
   else if (type == "rough") t.type = TerrainConfig::Type::Rough;
   else throw ConfigError(file, f.path("type"), "expected plane, composite or rough, found '" + type + "'");
+  if (t.type != TerrainConfig::Type::Rough)  // they would be ignored: a forgotten `type: rough`
+    for (const char* key : {"heightmap_image", "resolution", "size", "height_range", "seed"})
+      if (f.has(key)) throw ConfigError(file, f.path(key), "belongs to a rough terrain; this one is " + type);
   t.ground_plane = f.flag("ground_plane", true);
   t.heightmap_image = f.text("heightmap_image", "");
   if (!t.heightmap_image.empty() && t.heightmap_image[0] != '/') {
@@ -154,7 +156,7 @@ void parseTerrain(const YAML::Node& n, TerrainConfig& t, const std::string& file
   }
   t.resolution = static_cast<int>(f.integer("resolution", t.resolution, 8, 4096));
   if (f.has("size")) {
-    const double s = f.positive("size", 5.0);
+    const double s = f.within("size", 5.0, kMinTerrainSize, kMaxTerrainSize);
     t.size_x = t.size_y = s;
   }
   t.height_range = f.number("height_range", 0.0);
@@ -190,6 +192,10 @@ void parseTerrain(const YAML::Node& n, TerrainConfig& t, const std::string& file
     t.boxes.push_back({"arena_south", Vec3(0, -o, h / 2), Vec3(s + 2 * th, th, h), 0, 0, surface});
     t.boxes.push_back({"arena_east", Vec3(o, 0, h / 2), Vec3(th, s, h), 0, 0, surface});
     t.boxes.push_back({"arena_west", Vec3(-o, 0, h / 2), Vec3(th, s, h), 0, 0, surface});
+    for (std::size_t i = 0; i + 4 < t.boxes.size(); ++i)
+      if (t.boxes[i].name.rfind("arena_", 0) == 0)
+        throw ConfigError(file, f.path("boxes") + "[" + std::to_string(i) + "].name",
+                          "'" + t.boxes[i].name + "' is the name of one of the arena's walls (arena_north/south/east/west)");
   }
 }
 
@@ -208,7 +214,8 @@ void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
     throw ConfigError(file, f.path("gravity"), "must be <= " + std::to_string(static_cast<int>(kMaxGravity)) +
                                                    " m/s^2 (100 g; no contact holds beyond)");
   w.solver_iterations = static_cast<int>(f.integer("solver_iterations", w.solver_iterations, 1, 100000));
-  w.solver_sor = f.positive("solver_sor", w.solver_sor);
+  // Successive over-relaxation converges only below 2; above, ODE's solve diverges and aborts.
+  w.solver_sor = f.within("solver_sor", w.solver_sor, 0.01, 1.99);
   w.lock_idle_turret = f.flag("lock_idle_turret", w.lock_idle_turret);
   if (const YAML::Node c = f.node("contact")) {
     Fields cf(c, "world.contact", file);
@@ -336,6 +343,8 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
     const int count = robot_count >= 0 ? robot_count : static_cast<int>(sw.integer("count", 0, 0, kMaxRobots));
     const std::string level = checkLevel(sw.text("level", "simple"), file, "swarm.level");
     const std::string layout = sw.text("layout", "grid");
+    if (layout != "grid" && layout != "random")
+      throw ConfigError(file, "swarm.layout", "expected grid or random, found '" + layout + "'");
     const double spacing = sw.positive("spacing", 0.3);
     double cx = 0, cy = 0;
     sw.xy("center", &cx, &cy);
@@ -396,6 +405,11 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
       if (kind == "front_gripper") link.kind = 1;
       else if (kind == "side_arm") link.kind = 2;
       else throw ConfigError(file, l.path("kind"), "expected front_gripper or side_arm, found '" + kind + "'");
+      // A gripper holds one robot: a second link would silently replace the first.
+      for (std::size_t k = 0; k < s.links.size(); ++k)
+        if (s.links[k].holder == link.holder && s.links[k].kind == link.kind)
+          throw ConfigError(file, path, "'" + link.holder + "' already holds '" + s.links[k].held + "' with its " + kind +
+                                            " (links[" + std::to_string(k) + "]); it holds one robot");
       s.links.push_back(link);
     }
   }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -74,6 +75,13 @@ HeightMap makeHeightMap(const TerrainConfig& t) {
     const int n = std::max(8, t.resolution);
     map.rows = map.cols = n;
     raw = fractalNoise(n, t.heightmap_seed);
+  }
+  const double cell = std::min(map.size_x / (map.cols - 1), map.size_y / (map.rows - 1));
+  if (!(cell >= kMinTerrainCell)) {
+    std::ostringstream why;
+    why << map.cols << " x " << map.rows << " samples over " << map.size_x << " x " << map.size_y << " m make cells of "
+        << cell * 1000 << " mm; at least " << kMinTerrainCell * 1000 << " mm (a larger size or fewer samples)";
+    throw ConfigError(t.heightmap_image.empty() ? "(generated height map)" : t.heightmap_image, "terrain.size", why.str());
   }
   // An image's grey levels are absolute (0 -> 0 m, 255 -> height_range); generated noise is
   // stretched to span the whole range.

@@ -34,7 +34,12 @@ std::string problemIn(const YAML::Node& node, Walk& w) {
   } else {
     std::map<std::string, int> first_line;
     for (const auto& kv : node) {
-      if (kv.first.IsScalar()) {
+      if (!kv.first.IsScalar()) {
+        problem = "a key at line " + std::to_string(kv.first.Mark().line + 1) +
+                  " is not a name (a list, a mapping or nothing: `? [a, b]: ...`); keys here are names";
+        break;
+      }
+      {
         const int line = kv.first.Mark().line + 1;
         const auto [it, fresh] = first_line.emplace(kv.first.Scalar(), line);
         if (!fresh) {

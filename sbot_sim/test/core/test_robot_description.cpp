@@ -25,13 +25,13 @@ std::string read(const std::string& path) {
   return ss.str();
 }
 
-/// The Simple level's two files, copied into a fresh folder so that one value can be broken.
+/// A level's two files (Simple's unless named), copied into a fresh folder so that one value can be broken.
 class BrokenCopy {
  public:
-  BrokenCopy() {
+  explicit BrokenCopy(const std::string& level = "simple") : level_(level) {
     char dir[] = "/tmp/sbot_description_XXXXXX";
     dir_ = mkdtemp(dir);
-    const std::string src = descriptionDirectory() + "/urdf/simple";
+    const std::string src = descriptionDirectory() + "/urdf/" + level;
     urdf_ = read(src + ".urdf");
     sidecar_ = read(src + ".sbot.yaml");
   }
@@ -40,8 +40,8 @@ class BrokenCopy {
     std::remove(sidecarPath().c_str());
     rmdir(dir_.c_str());
   }
-  std::string urdfPath() const { return dir_ + "/simple.urdf"; }
-  std::string sidecarPath() const { return dir_ + "/simple.sbot.yaml"; }
+  std::string urdfPath() const { return dir_ + "/" + level_ + ".urdf"; }
+  std::string sidecarPath() const { return dir_ + "/" + level_ + ".sbot.yaml"; }
 
   /// Replace the first `from` found after `anchor` in the URDF (or the sidecar).
   void breakUrdf(const std::string& anchor, const std::string& from, const std::string& to) { replace(urdf_, anchor, from, to); }
@@ -67,7 +67,7 @@ class BrokenCopy {
     ASSERT_NE(i, std::string::npos) << "'" << from << "' not in the file after '" << anchor << "'";
     text.replace(i, from.size(), to);
   }
-  std::string dir_, urdf_, sidecar_;
+  std::string level_, dir_, urdf_, sidecar_;
 };
 
 TEST(RobotDescription, TheUnbrokenCopyLoads) { EXPECT_EQ(BrokenCopy().loadError(), ""); }
@@ -101,7 +101,6 @@ TEST(RobotDescription, MotorNumbersMustBeFiniteAndPositive) {
       {"  speed_unit: 0.0028", "treels.speed_unit"},
       {"  gear_ratio: 150", "treels.gear_ratio"},
       {"  wheel_radius: 0.022", "treels.wheel_radius"},
-      {"recommended_step: 0.01", "recommended_step"},
       {"  friction_scale: 2", "treels.friction_scale"},
       {"  friction_force_limit: 1.2", "treels.friction_force_limit"},
   };
@@ -112,6 +111,13 @@ TEST(RobotDescription, MotorNumbersMustBeFiniteAndPositive) {
       EXPECT_NE(c.loadError().find("simple.sbot.yaml: field '" + field + "': must be a finite number > 0"), std::string::npos)
           << line << " -> " << bad << ": " << c.loadError();
     }
+  }
+  // The level's step: a world's range (a 5 s "step" ran no step at all, or one of 245 m falls).
+  for (const std::string bad : {".nan", "0", "-1", "5", "1e-300"}) {
+    BrokenCopy step;
+    step.breakSidecar("recommended_step: 0.01", "recommended_step: " + bad);
+    EXPECT_NE(step.loadError().find("field 'recommended_step': expected a step in [0.0001, 0.5] s"), std::string::npos)
+        << bad << ": " << step.loadError();
   }
   BrokenCopy law;
   law.breakSidecar("friction_law: coulomb", "friction_law: sticky");
@@ -212,6 +218,54 @@ TEST(RobotDescription, SidecarEntriesAreCheckedWhenTheyLoad) {
     EXPECT_NE(e.find("simple.sbot.yaml: field '" + c[1].first + "': "), std::string::npos) << c[0].second << ": " << e;
     EXPECT_NE(e.find(c[1].second), std::string::npos) << c[0].second << ": " << e;
   }
+}
+
+// A second outside probe (2026-11-29, thirty-fifth session): these descriptions aborted the process
+// inside ODE (an inertia that is not positive definite, 1e300 offsets or gravity, a NaN loop-joint
+// anchor or a zero axis), or escaped as std::out_of_range (a fixed turret joint) or as yaml-cpp's
+// own words (a section that is no mapping, a key that is a list), or loaded with a typo or a
+// contradiction unseen. Each is now refused when it loads, naming the field.
+TEST(RobotDescription, WhatODEWouldAbortOnIsRefusedWhenItLoads) {
+  struct Case {
+    std::string level, file, anchor, from, to, field, words;
+  };
+  const Case cases[] = {
+      {"simple", "urdf", "<link name=\"base_link\">", "ixy=\"0\"", "ixy=\"1\"", "link base_link/inertial/inertia",
+       "must be positive definite"},
+      {"simple", "urdf", "<link name=\"base_link\">", "ixx=\"3.385e-05\"", "ixx=\"1e300\"",
+       "link base_link/inertial/inertia", "must be at most 1000 kg m^2"},
+      {"simple", "urdf", "<joint name=\"left_wheel_joint\"", "xyz=\"0 0.041 0\"", "xyz=\"1e300 0.041 0\"",
+       "joint left_wheel_joint/origin xyz", "must be at most 100 m"},
+      {"simple", "sidecar", "", "turret: {joint: turret_joint", "turret: {joint: caster_front_joint", "turret.joint",
+       "must be revolute or continuous, found fixed"},
+      {"simple", "sidecar", "", "gravity: 9.81", "gravity: 1e300", "gravity", "must be at most 1000 m/s^2"},
+      {"simple", "sidecar", "", "turret: {joint: turret_joint", "turret: 5  # {joint: turret_joint", "turret",
+       "expected a mapping"},
+      {"simple", "sidecar", "", "  wheel_radius: 0.022", "  wheel_radius: 0.022\n  bogus_key: 5", "treels.bogus_key",
+       "unknown field"},
+      {"simple", "sidecar", "", "left_joints: [left_wheel_joint]", "left_joints: [right_wheel_joint]",
+       "treels.left_joints/right_joints", "'right_wheel_joint' is listed twice"},
+      {"simple", "sidecar", "", "wheel_radii: {}", "wheel_radii: {no_such_joint: 0.05}", "treels.wheel_radii.no_such_joint",
+       "not a driven joint"},
+      {"simple", "sidecar", "", "grip_point: 0.03", "grip_point: .nan", "gripper.grip_point", "must be finite"},
+      {"detailed", "sidecar", "", "anchor_in_parent: [0.02, 0, 0]", "anchor_in_parent: [.nan, 0, 0]",
+       "side_arm.loop_joints[0].anchor_in_parent", "must be finite"},
+      {"detailed", "sidecar", "", "axis: [0, 0, 1]", "axis: [0, 0, 0]", "side_arm.loop_joints[0].axis", "zero axis"},
+      {"detailed", "sidecar", "", "side_arm_cross_1a_joint,", "side_arm_cross_9_joint,", "side_arm.passive_joints[0]",
+       "no joint 'side_arm_cross_9_joint'"},
+  };
+  for (const Case& c : cases) {
+    BrokenCopy copy(c.level);
+    if (c.file == "urdf") copy.breakUrdf(c.anchor, c.from, c.to);
+    else copy.breakSidecar(c.from, c.to);
+    const std::string e = copy.loadError();
+    EXPECT_NE(e.find(c.level + (c.file == "urdf" ? ".urdf" : ".sbot.yaml") + ": field '" + c.field + "': "),
+              std::string::npos) << c.to << ": " << e;
+    EXPECT_NE(e.find(c.words), std::string::npos) << c.to << ": " << e;
+  }
+  BrokenCopy complex_key;
+  complex_key.breakSidecar("materials: {base_link: chassis", "materials: {? [base_link]: chassis");
+  EXPECT_NE(complex_key.loadError().find("is not a name"), std::string::npos) << complex_key.loadError();
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/scenario.h"
+#include "sbot_sim/core/terrain.h"
 #include "sbot_sim/core/world.h"
 
 namespace sbot {
@@ -123,6 +124,30 @@ TEST(Scenario, RefusesValuesThatWouldMisbehaveLater) {
   refused("world: {terrain: {type: composite, boxes: [{name: a, center: [1, 0, 0]}, {name: a, center: [2, 0, 0]}]}}",
           "'world.terrain.boxes[1].name': 'a' names another box too");
   refused("world: {gravity: 1e30}", "'world.gravity': must be <= 1000 m/s^2");
+  // Aborted inside ODE, or hung there (an outside probe, 2026-11-29, thirty-fifth session):
+  // over-relaxation from 2 on diverges; a rough terrain of 1 cm took minutes a step, of 1e-300 m aborted.
+  refused("world: {solver_sor: 3}", "'world.solver_sor': must be in [0.01, 1.99], found 3");
+  refused("world: {terrain: {type: rough, size: 0.01}}", "'world.terrain.size': must be in [0.1, 10000], found 0.01");
+  refused("world: {contact: {materials: {? [track]: 1}}}", "a key at line 1 is not a name");
+  // Accepted and ignored before: a rough terrain's fields on another kind, an unknown layout of
+  // nobody, a box with an arena wall's name.
+  refused("world: {terrain: {type: plane, heightmap_image: hills.png}}",
+          "'world.terrain.heightmap_image': belongs to a rough terrain; this one is plane");
+  refused("swarm: {count: 0, layout: spiral}", "'swarm.layout': expected grid or random, found 'spiral'");
+  refused("world: {terrain: {type: composite, boxes: [{name: arena_north, center: [1, 0, 0]}], arena: {size: 2}}}",
+          "'world.terrain.boxes[0].name': 'arena_north' is the name of one of the arena's walls");
+  TerrainConfig fine;
+  fine.type = TerrainConfig::Type::Rough;
+  fine.size_x = fine.size_y = 0.1;  // 128 samples: 0.79 mm cells
+  try {
+    makeHeightMap(fine);
+    ADD_FAILURE() << "a height field of sub-millimetre cells was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("field 'terrain.size': 128 x 128 samples over 0.1 x 0.1 m make cells of 0.787"),
+              std::string::npos) << e.what();
+  }
+  fine.resolution = 64;  // 1.6 mm cells
+  EXPECT_EQ(makeHeightMap(fine).rows, 64);
   refused("swarm: {count: 2, center: [0, .nan]}", "'swarm.center': must be finite");
   refused("swarm: {count: 2, center: [0, here]}", "'swarm.center': expected [x, y] of numbers");
   refused("world: {terrain: {type: composite, boxes: [{center: [0, 0]}]}}", "'world.terrain.boxes[0].center': expected [x, y, z]");

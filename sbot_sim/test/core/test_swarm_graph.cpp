@@ -83,6 +83,17 @@ TEST(SwarmGraph, MalformedLinksAreReported) {
   EXPECT_THROW(parseScenario(std::string(base) + "links: [{holder: a, held: b, kind: glue}]", "<x>"), ConfigError);
   EXPECT_THROW(parseScenario(std::string(base) + "links: [{holder: a, held: b, colour: red}]", "<x>"), ConfigError);
   EXPECT_NO_THROW(parseScenario(std::string(base) + "links: [{holder: a, held: b, kind: side_arm}]", "<x>"));
+  // A gripper holds one robot: a second link of the same holder and kind replaced the first unseen.
+  try {
+    parseScenario("robots: [{name: a}, {name: b}, {name: c}]\nlinks: [{holder: a, held: b}, {holder: a, held: c}]", "<x>");
+    ADD_FAILURE() << "a second front-gripper link of one holder was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("field 'links[1]': 'a' already holds 'b' with its front_gripper (links[0])"),
+              std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(parseScenario("robots: [{name: a}, {name: b}, {name: c}]\n"
+                                "links: [{holder: a, held: b}, {holder: a, held: c, kind: side_arm}]", "<x>"))
+      << "its side arm may hold another";
 }
 
 }  // namespace

@@ -16,6 +16,12 @@ namespace sbot {
 /// step given in the wrong unit; per-robot buffers sized window / step run out of memory); above,
 /// no level's contacts hold (the Fast level's 100 ms is the largest the seed uses).
 constexpr double kMinStep = 1e-4, kMaxStep = 0.5;
+/// [m/s^2] the largest gravity a world or a level accepts (100 g; no contact holds beyond).
+constexpr double kMaxGravity = 1000;
+/// [m] a rough terrain's side, and the finest cell of its height field (side / (samples - 1)): a
+/// robot over finer cells meets tens of thousands of triangles a step, and ODE's height-field
+/// collider stalls (0.08 mm cells: minutes per step) or, for a vanishing side, aborts.
+constexpr double kMinTerrainSize = 0.1, kMaxTerrainSize = 1e4, kMinTerrainCell = 0.001;
 
 /// Contact model. Materials are named by the sidecar (`materials`) and by obstacles (`surface`).
 struct ContactConfig {

@@ -16,6 +16,8 @@ namespace sbot {
 ///   until the stack overflowed;
 /// - aliases nested to multiply the document past a million values ("billion laughs"), which made
 ///   a walk run for hours.
+/// - a key that is a list or a mapping (`? [a]: 1`), which every loader reads as a name and which
+///   then escaped as yaml-cpp's "bad conversion".
 std::string yamlStructureProblem(const YAML::Node& node);
 
 /// The first key of mapping `node` that is not in `allowed` (its name: Scalar(), its place: Mark()),
