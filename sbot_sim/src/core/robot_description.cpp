@@ -1,6 +1,7 @@
 #include "sbot_sim/core/robot_description.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -427,6 +428,30 @@ void parseSidecar(RobotDescription& d) {
       }
       if (!std::isfinite(v)) throw ConfigError(file, section + "." + key, "must be finite");
     }
+  }
+  // Speeds, torques, forces and sizes of the grippers: a zero made a jaw that never closes (its
+  // delay is aperture / speed) and an arm without limits. And their ranges must be ranges.
+  const auto number = [&](const char* section, const char* key) { return root[section][key].as<double>(); };
+  const std::pair<const char*, std::vector<const char*>> positives[] = {
+      {"gripper", {"aperture_max", "elevation_speed", "elevation_torque", "jaw_force", "jaw_length", "jaw_speed", "jaw_torque"}},
+      {"side_arm", {"link_length", "rhombi", "rotation_range", "unit", "elevation_torque", "horizontal_torque",
+                    "servo_speed", "jaw_force", "jaw_speed", "jaw_torque", "aperture_max"}}};
+  for (const auto& [section, keys] : positives)
+    for (const char* key : keys)
+      if (root[section] && root[section][key] && !(number(section, key) > 0))
+        throw ConfigError(file, std::string(section) + "." + key, "must be > 0");
+  const std::array<const char*, 4> ordered[] = {{"gripper", "elevation_lower", "elevation_upper", ""},
+                                                {"side_arm", "half_angle_min", "rest_half_angle", "half_angle_max"}};
+  for (const auto& o : ordered) {
+    const char* section = o[0];
+    if (!root[section]) continue;
+    std::vector<const char*> given;
+    for (int k = 1; k < 4; ++k)
+      if (*o[k] && root[section][o[k]]) given.push_back(o[k]);
+    for (std::size_t k = 1; k < given.size(); ++k)
+      if (!(number(section, given[k - 1]) < number(section, given[k])))
+        throw ConfigError(file, std::string(section) + "." + given[k - 1],
+                          std::string("must be below ") + section + "." + given[k]);
   }
   d.level = get<std::string>(root, "level", "", file, "");
   if (d.level.empty()) throw ConfigError(file, "level", "missing");

@@ -253,6 +253,13 @@ TEST(RobotDescription, WhatODEWouldAbortOnIsRefusedWhenItLoads) {
       {"detailed", "sidecar", "", "axis: [0, 0, 1]", "axis: [0, 0, 0]", "side_arm.loop_joints[0].axis", "zero axis"},
       {"detailed", "sidecar", "", "side_arm_cross_1a_joint,", "side_arm_cross_9_joint,", "side_arm.passive_joints[0]",
        "no joint 'side_arm_cross_9_joint'"},
+      // Read by the node's gripper modules only, and wrong there without a word: a jaw that never
+      // closed (its delay is aperture / speed), limits that were no range.
+      {"detailed", "sidecar", "", "jaw_speed: 1", "jaw_speed: 0", "gripper.jaw_speed", "must be > 0"},
+      {"detailed", "sidecar", "", "elevation_upper: 1.5707963", "elevation_upper: -2", "gripper.elevation_lower",
+       "must be below gripper.elevation_upper"},
+      {"detailed", "sidecar", "", "half_angle_max: 1.3962634", "half_angle_max: 0.1", "side_arm.rest_half_angle",
+       "must be below side_arm.half_angle_max"},
   };
   for (const Case& c : cases) {
     BrokenCopy copy(c.level);
