@@ -661,6 +661,12 @@ bool RobotModulesRos::onSetSamplingRate(sbot_msgs::SetSamplingRate::Request& req
     }
     hz = req.hz;
   }
+  // A channel is published at most once a step: the reply says the rate it gets (it said 1e300).
+  const double step_hz = 1.0 / world_->config().step;
+  if (hz > step_hz) {
+    res.message = "capped at the step rate " + std::to_string(step_hz) + " Hz (asked " + std::to_string(hz) + ")";
+    hz = step_hz;
+  }
   it->second.hz = hz;
   it->second.next = 0;  // publish at the next step, then every 1/hz
   next_any_ = 0;
@@ -717,6 +723,8 @@ void ModulesRosInterface::attach() {
   for (const sbot::LampSpawn& l : lamps_) env_->addLamp(l.position, l.intensity, l.colour);
   env_->setAmbientLight(ambient_);
   bound_world_ = world_.get();
+  for (auto it = robots_.begin(); it != robots_.end();)  // robots spawned since the world was built
+    it = world_->findRobot(it->first) ? std::next(it) : robots_.erase(it);
   for (sbot::Robot* r : world_->robots()) modulesFor(r->name()).bind(*world_, *env_, *r);
 }
 
@@ -739,7 +747,10 @@ void ModulesRosInterface::robotAdded(sbot::Robot& robot) {
 
 void ModulesRosInterface::robotRemoving(sbot::Robot& robot) {
   auto it = robots_.find(robot.name());
-  if (it != robots_.end()) it->second->unbind();
+  if (it != robots_.end()) {  // its topics and services go with it (SwarmRosInterface::onDelete)
+    it->second->unbind();
+    robots_.erase(it);
+  }
   if (env_) env_->forgetRobot(robot.name());
 }
 

@@ -388,10 +388,19 @@ bool SimRosInterface::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Re
     world_.reset();  // the old world is gone: run() exits with an error
     return true;
   }
-  for (auto& iface : robots_) {
-    sbot::Robot* r = world_->findRobot(iface->name());
-    if (r) iface->bind(*r);
+  // The interfaces follow the rebuilt world: robots spawned since have none now, deleted ones of the
+  // scenario are back (a new interface on the same names).
+  std::vector<std::unique_ptr<RobotRosInterface>> interfaces;
+  for (sbot::Robot* r : world_->robots()) {
+    auto it = std::find_if(robots_.begin(), robots_.end(), [&](const auto& iface) { return iface && iface->name() == r->name(); });
+    if (it != robots_.end()) {
+      (*it)->bind(*r);
+      interfaces.push_back(std::move(*it));
+    } else {
+      interfaces.push_back(std::make_unique<RobotRosInterface>(nh_, *r, params_.set_description_params));
+    }
   }
+  robots_ = std::move(interfaces);  // (SwarmRosInterface holds a reference to this vector)
   if (modules_) modules_->attach();
   ++reset_count_;
   if (markers_) markers_->clearTrails();

@@ -82,6 +82,11 @@ class Modules(unittest.TestCase):
         self.assertFalse(srv(channel='proximity', rate=42, hz=0).success)
         self.assertFalse(srv(channel='nonsense', rate=4, hz=0).success)
         self.assertFalse(srv(channel='slope', rate=0, hz=float('nan')).success)
+        # Above the step rate (100 Hz here) the reply said the rate asked (1e300), not the one given.
+        res = srv(channel='slope', rate=0, hz=1e300)
+        self.assertTrue(res.success, res.message)
+        self.assertEqual(res.applied_hz, 100.0)
+        self.assertIn('capped at the step rate', res.message)
         self.assertTrue(srv(channel='proximity', rate=4, hz=0).success)
 
     def test_range_per_ir_when_subscribed(self):

@@ -137,6 +137,15 @@ class TestSwarm(unittest.TestCase):
         self.assertNotIn('sbot_0', g.names)
         self.assertEqual(sum(g.connections), 0)
         self.assertEqual(len(set(g.component)), 3)
+        # Its topics go with it (kept, every name ever spawned held ~50 topics for good), and a spawn
+        # of the same name brings them back.
+        published = lambda: [name for name, _ in rospy.get_published_topics()]
+        self.assertNotIn('/sbot_0/model_level', published())
+        self.assertIn('/sbot_9/model_level', published())
+        res = self.spawn('sbot_0', 'simple', 1.0, -1.0, 0.0)
+        self.assertTrue(res.success, res.message)
+        level = rospy.wait_for_message('/sbot_0/model_level', ModelLevel, timeout=10.0)
+        self.assertEqual(level.level, 'simple')
 
 
 if __name__ == '__main__':
