@@ -522,12 +522,17 @@ void RobotModulesRos::publishMarkers(const ros::Time& stamp) {
 void RobotModulesRos::onLeds(const sbot_msgs::LedState::ConstPtr& msg) {
   if (!robot_) return;
   std::array<unsigned, sn::kLedGroups> r{}, g{}, b{}, blink{};
+  bool clamped = false;  // the light ring clamps colours to 0..15; the blink code is capped here
   for (int k = 0; k < sn::kLedGroups; ++k) {
     r[k] = msg->r[k];
     g[k] = msg->g[k];
     b[k] = msg->b[k];
     blink[k] = std::min<unsigned>(msg->blink[k], 10);
+    clamped |= std::max({r[k], g[k], b[k]}) > sn::kLedMaxUnits || msg->blink[k] > 10;
   }
+  if (clamped)  // as cmd_speed warns, and set_leds answers `clamped`
+    ROS_WARN_THROTTLE(1.0, "%s/leds: colour above 15 or blink code above 10 clamped (sbot.h ranges: 0..15, 0..10)",
+                      name_.c_str());
   suite_->setAllLightColor(r, g, b, blink);
 }
 
