@@ -192,7 +192,7 @@ void applyStudyKnobs(WorldConfig& c) {
   // polystyrene keeps kPolystyreneTrackMu); each level's treels.friction_scale still multiplies it.
   if (const char* e = std::getenv("SBOT_VALIDATE_TRACK_MU"))
     c.contact.material_mu["track"] = number("SBOT_VALIDATE_TRACK_MU", e, 0.0, 100.0, "[0, 100]");
-  if (const char* e = std::getenv("SBOT_VALIDATE_SOR")) c.solver_sor = number("SBOT_VALIDATE_SOR", e, 0.1, 1.99, "[0.1, 1.99]");
+  if (const char* e = std::getenv("SBOT_VALIDATE_SOR")) c.solver_sor = number("SBOT_VALIDATE_SOR", e, 0.1, kMaxSolverSor, "[0.1, 1.99]");
   // Contact softness study: ODE's soft_erp and soft_cfm of every contact.
   if (const char* e = std::getenv("SBOT_VALIDATE_CONTACT_ERP")) c.contact.erp = number("SBOT_VALIDATE_CONTACT_ERP", e, 0.01, 1.0, "[0.01, 1]");
   if (const char* e = std::getenv("SBOT_VALIDATE_CONTACT_CFM")) c.contact.cfm = number("SBOT_VALIDATE_CONTACT_CFM", e, 0.0, 1.0, "[0, 1]");

@@ -370,9 +370,6 @@ static void checkSideArm(const YAML::Node& arm, const RobotDescription& d, const
       }
     }
   }
-  // Divisors of the arm's kinematics (SideArm): a zero turns its limits into infinities.
-  for (const char* key : {"unit", "link_length", "rhombi"})
-    if (arm[key]) requirePositive(get<double>(arm, key, 1.0, file, "side_arm."), file, std::string("side_arm.") + key);
 }
 
 void parseSidecar(RobotDescription& d) {

@@ -188,11 +188,12 @@ void parseTerrain(const YAML::Node& n, TerrainConfig& t, const std::string& file
     const double s = a.positive("size", 4.0), h = a.positive("height", 0.1), th = a.positive("thickness", 0.02);
     const std::string surface = a.text("surface", "wall");
     const double o = s / 2 + th / 2;
+    const std::size_t own_boxes = t.boxes.size();
     t.boxes.push_back({"arena_north", Vec3(0, o, h / 2), Vec3(s + 2 * th, th, h), 0, 0, surface});
     t.boxes.push_back({"arena_south", Vec3(0, -o, h / 2), Vec3(s + 2 * th, th, h), 0, 0, surface});
     t.boxes.push_back({"arena_east", Vec3(o, 0, h / 2), Vec3(th, s, h), 0, 0, surface});
     t.boxes.push_back({"arena_west", Vec3(-o, 0, h / 2), Vec3(th, s, h), 0, 0, surface});
-    for (std::size_t i = 0; i + 4 < t.boxes.size(); ++i)
+    for (std::size_t i = 0; i < own_boxes; ++i)
       if (t.boxes[i].name.rfind("arena_", 0) == 0)
         throw ConfigError(file, f.path("boxes") + "[" + std::to_string(i) + "].name",
                           "'" + t.boxes[i].name + "' is the name of one of the arena's walls (arena_north/south/east/west)");
@@ -214,8 +215,7 @@ void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
     throw ConfigError(file, f.path("gravity"), "must be <= " + std::to_string(static_cast<int>(kMaxGravity)) +
                                                    " m/s^2 (100 g; no contact holds beyond)");
   w.solver_iterations = static_cast<int>(f.integer("solver_iterations", w.solver_iterations, 1, 100000));
-  // Successive over-relaxation converges only below 2; above, ODE's solve diverges and aborts.
-  w.solver_sor = f.within("solver_sor", w.solver_sor, 0.01, 1.99);
+  w.solver_sor = f.within("solver_sor", w.solver_sor, 0.01, kMaxSolverSor);
   w.lock_idle_turret = f.flag("lock_idle_turret", w.lock_idle_turret);
   if (const YAML::Node c = f.node("contact")) {
     Fields cf(c, "world.contact", file);

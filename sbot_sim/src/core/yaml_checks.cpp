@@ -39,14 +39,12 @@ std::string problemIn(const YAML::Node& node, Walk& w) {
                   " is not a name (a list, a mapping or nothing: `? [a, b]: ...`); keys here are names";
         break;
       }
-      {
-        const int line = kv.first.Mark().line + 1;
-        const auto [it, fresh] = first_line.emplace(kv.first.Scalar(), line);
-        if (!fresh) {
-          problem = "key '" + kv.first.Scalar() + "' appears twice in one mapping (lines " + std::to_string(it->second) +
-                    " and " + std::to_string(line) + ")";
-          break;
-        }
+      const int line = kv.first.Mark().line + 1;
+      const auto [it, fresh] = first_line.emplace(kv.first.Scalar(), line);
+      if (!fresh) {
+        problem = "key '" + kv.first.Scalar() + "' appears twice in one mapping (lines " + std::to_string(it->second) +
+                  " and " + std::to_string(line) + ")";
+        break;
       }
       if (problem = problemIn(kv.second, w); !problem.empty()) break;
     }

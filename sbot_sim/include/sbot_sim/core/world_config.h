@@ -16,6 +16,8 @@ namespace sbot {
 /// step given in the wrong unit; per-robot buffers sized window / step run out of memory); above,
 /// no level's contacts hold (the Fast level's 100 ms is the largest the seed uses).
 constexpr double kMinStep = 1e-4, kMaxStep = 0.5;
+/// [-] quickstep's over-relaxation converges only below 2; from 2 on ODE's solve diverges and aborts.
+constexpr double kMaxSolverSor = 1.99;
 /// [m/s^2] the largest gravity a world or a level accepts (100 g; no contact holds beyond).
 constexpr double kMaxGravity = 1000;
 /// [m] a rough terrain's side, and the finest cell of its height field (side / (samples - 1)): a
