@@ -270,7 +270,7 @@ TEST(ToolsCli, ProbedTablesAndOptionsAreRunOrRefusedAsTheySay) {
 }
 
 // A table's cells can drive at another speed than the seed's 2.8 cm/s (speed_units): the Medium is
-// stuck in a 4 cm gap at 2.8 cm/s and crosses it on its momentum at 16.8 cm/s (the seed's reason for
+// stuck in a 4.5 cm gap at 2.8 cm/s and crosses it on its momentum at 16.8 cm/s (the seed's reason for
 // driving slowly, 4.2.3); the report then shows each cell's speed, and the variants that tell the two
 // rows apart (without a variant_header they used to be hidden).
 TEST(ToolsCli, ATableCellDrivesAtItsOwnSpeed) {
@@ -280,13 +280,13 @@ TEST(ToolsCli, ATableCellDrivesAtItsOwnSpeed) {
                                        "      id: fast_gap\n      title: Gap at two speeds\n      group: lab\n"
                                        "      experiment: gap\n      level: medium\n      param: {unit: cm, scale: 100, decimals: 1}\n"
                                        "      references: [measured]\n      cells:\n"
-                                       "        - {param: 0.040, variant: slow, measured: stuck}\n"
-                                       "        - {param: 0.040, variant: fast, speed_units: 60, measured: pass}\n";
+                                       "        - {param: 0.045, variant: slow, measured: stuck}\n"
+                                       "        - {param: 0.045, variant: fast, speed_units: 60, measured: pass}\n";
   const Outcome o = sbot_test::runProcess(std::string(SWARMBOT3D_BIN_DIR) + "/sbot_validate --trials 1 --jobs 1 --out " + dir +
                                           "report --tables " + dir + "speed.yaml");
   EXPECT_EQ(o.status, 0) << o.output;
-  EXPECT_NE(o.output.find("| 4.0 cm | slow | 2.80 | stuck | stuck (stuck 1/1) | match |"), std::string::npos) << o.output;
-  EXPECT_NE(o.output.find("| 4.0 cm | fast | 16.80 | pass | pass (pass 1/1) | match |"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("| 4.5 cm | slow | 2.80 | stuck | stuck (stuck 1/1) | match |"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("| 4.5 cm | fast | 16.80 | pass | pass (pass 1/1) | match |"), std::string::npos) << o.output;
 }
 
 // A model description that cannot be read ($SBOT_DESCRIPTION_DIR, the sweep tool's variants): two_sbots
