@@ -252,21 +252,21 @@ TEST(ToolsCli, ProbedTablesAndOptionsAreRunOrRefusedAsTheySay) {
   expectRefused("sbot_validate", out + "--tables " + dir, "--tables: reference tables " + dir + ": is a directory");
   // A table of one's own, named like a seed cell, mismatching: the seed's reason is not shown for it.
   std::ofstream(dir + "mine.yaml") << "groups:\n  - {name: mine, title: Mine}\n"
-                                      "report:\n  - table:\n      id: \"4.5\"\n      title: Mine\n      group: mine\n      experiment: gap\n"
-                                      "      param: {unit: cm, scale: 100, decimals: 1}\n      references: [measured]\n"
-                                      "      cells:\n        - {param: 0.040, level: simple, measured: pass}\n"
-                                      "        - {param: 0.030, level: fast, measured: pass}\n";
+                                      "report:\n  - table:\n      id: \"4.6\"\n      title: Mine\n      group: mine\n      experiment: uphill\n"
+                                      "      param: {unit: rad, scale: 1, decimals: 2}\n      references: [measured]\n"
+                                      "      cells:\n        - {param: 0.04, level: simple, measured: stuck}\n"
+                                      "        - {param: 0.02, level: fast, measured: climb}\n";
   const Outcome mine = run("sbot_validate", "--trials 1 --jobs 1 " + out + "--tables " + dir + "mine.yaml");
-  EXPECT_NE(mine.output.find("| 4.0 cm | simple | pass | stuck"), std::string::npos) << mine.output;
-  EXPECT_NE(mine.output.find("*4.5 4.0 cm simple*: **not explained yet**"), std::string::npos) << mine.output;
+  EXPECT_NE(mine.output.find("| 0.04 rad | simple | stuck | climb"), std::string::npos) << mine.output;
+  EXPECT_NE(mine.output.find("*4.6 0.04 rad simple*: **not explained yet**"), std::string::npos) << mine.output;
   // With a reasons file that names a cell the tables do not have: a warning naming it.
-  std::ofstream(dir + "reasons.yaml") << "\"4.5 4.0 cm simple\": why\n\"4.5 40 mm simple\": a typo\n";
+  std::ofstream(dir + "reasons.yaml") << "\"4.6 0.04 rad simple\": why\n\"4.6 0.4 rad simple\": a typo\n";
   const Outcome typo = run("sbot_validate", "--trials 1 --jobs 1 " + out + "--tables " + dir + "mine.yaml --reasons " + dir +
                                                  "reasons.yaml");
-  EXPECT_NE(typo.output.find("warning: " + dir + "reasons.yaml: the reason for '4.5 40 mm simple' names no cell"),
+  EXPECT_NE(typo.output.find("warning: " + dir + "reasons.yaml: the reason for '4.6 0.4 rad simple' names no cell"),
             std::string::npos)
       << typo.output;
-  EXPECT_NE(typo.output.find("*4.5 4.0 cm simple*: why"), std::string::npos) << typo.output;
+  EXPECT_NE(typo.output.find("*4.6 0.04 rad simple*: why"), std::string::npos) << typo.output;
 }
 
 // A table's cells can drive at another speed than the seed's 2.8 cm/s (speed_units): the Medium is

@@ -170,7 +170,10 @@ TEST(DriveEffects, LatencyDelaysTheStart) {
 
 TEST(DriveEffects, DeadBandSwallowsSmallCommands) {
   const std::vector<EffectConfig> band{{"dead_band", {{"threshold", 0.03}}, {}, ""}};
-  EXPECT_LT(distance(drive(band, 8, 8, 2.0)), 0.003) << "8 units = 2.2 cm/s is below a 3 cm/s dead-band";
+  // Below the band the robot does what it does standing (quickstep lets a standing Simple creep
+  // ~2 mm per second sideways); 8 units undamped would take it 4.4 cm.
+  EXPECT_NEAR(distance(drive(band, 8, 8, 2.0)), distance(drive({}, 0, 0, 2.0)), 0.001)
+      << "8 units = 2.2 cm/s is below a 3 cm/s dead-band";
   const double d = distance(drive(band, 50, 50, 2.0)), d0 = distance(drive({}, 50, 50, 2.0));
   EXPECT_NEAR(d0 - d, 0.03 * 2.0, 0.015) << "above it the track runs threshold slower";
 }
@@ -178,13 +181,14 @@ TEST(DriveEffects, DeadBandSwallowsSmallCommands) {
 TEST(DriveEffects, LagAndRampSlowTheAcceleration) {
   // Distance lost to the transient grows with the time constant / ramp time. (Not exactly v tau or
   // v t / 2: the nominal robot is itself slow to spin up its reflected rotor inertia, and the two
-  // transients overlap.)
+  // transients overlap: a 0.3 s lag loses 1.4 cm of v tau = 5 cm, 2.8 cm with the 20 g wheels
+  // before 2026-12-01.)
   const double d0 = distance(drive({}, 60, 60, 2.5));
   auto loss = [&](const char* effect, const char* param, double v) {
     return d0 - distance(drive({{effect, {{param, v}}, {}, ""}}, 60, 60, 2.5));
   };
   const double lag1 = loss("motor_lag", "tau", 0.3), lag2 = loss("motor_lag", "tau", 0.6);
-  EXPECT_GT(lag1, 0.015);
+  EXPECT_GT(lag1, 0.01);
   EXPECT_LT(lag1, 60 * 0.0028 * 0.3 + 0.005);
   EXPECT_GT(lag2, lag1 + 0.6 * 60 * 0.0028 * 0.3) << "each extra 0.3 s of lag loses ~v * 0.3 s";
   const double ramp1 = loss("accel_limit", "ramp_time", 1.0), ramp2 = loss("accel_limit", "ramp_time", 2.0);
@@ -203,8 +207,10 @@ TEST(DriveEffects, BatterySagSlowsWithBatteryTime) {
     sag->reset();
     sag->setElapsed("sbot_0", elapsed);
     r.setSpeed(40, 40);
+    runFor(w, 1.0);  // spun up: the start transient is shorter at the lower speed
+    const Vec3 start = r.basePose().position;
     runFor(w, 2.0);
-    return r.basePose().position.head<2>().norm();
+    return (r.basePose().position - start).head<2>().norm();
   };
   EXPECT_NEAR(sagged(240) / sagged(0), 0.8, 0.02) << "5 %/min for 4 min";
 }

@@ -82,11 +82,13 @@ TEST(FakeCamera, RangeElevationOcclusionAndBlinking) {
   EXPECT_TRUE(cam.blobs().empty());
   runFor(w, 0.25);
   EXPECT_EQ(cam.blobs().size(), 1u);
-  // Lamps: within +-70 deg elevation only.
-  const Vec3 cam_pos = a.linkPose("fake_camera").position;
-  env.addLamp(cam_pos + Vec3(1.0, 0, 1.0), 1000, Vec3(1, 1, 0));         // 45 deg up: seen
-  env.addLamp(cam_pos + Vec3(0.2, 0, 1.0), 1000);                         // 79 deg up: not seen
-  env.addLamp(cam_pos + Vec3(-2.0, 0.1, 0.0), 0.0);                       // switched off
+  // Lamps: within +-70 deg elevation only, in the camera's frame (the robot rocks a degree or two
+  // between its casters, so the lamps are placed in that frame).
+  const Pose cam_frame = a.linkPose("fake_camera");
+  auto at = [&](const Vec3& offset) { return Vec3(cam_frame.position + cam_frame.orientation * offset); };
+  env.addLamp(at(Vec3(1.0, 0, 1.0)), 1000, Vec3(1, 1, 0));         // 45 deg up: seen
+  env.addLamp(at(Vec3(0.2, 0, 1.0)), 1000);                         // 79 deg up: not seen
+  env.addLamp(at(Vec3(-2.0, 0.1, 0.0)), 0.0);                       // switched off
   blobs = cam.blobs();
   ASSERT_EQ(blobs.size(), 2u);
   EXPECT_EQ(blobs[0].source, "lamp");
