@@ -557,11 +557,13 @@ Dataset loadDatasetFields(const std::string& path_in) {
   // obstacles, lamps and ambient light.
   if (const YAML::Node w = root["world"]) {
     if (!w.IsMap()) fail(f, w, "world", "expected a mapping");
-    allowOnly(w, f, "world", {"step", "gravity", "solver", "solver_iterations", "solver_sor", "contact", "terrain",
-                              "obstacles", "lamps", "ambient_light"});
+    allowOnly(w, f, "world", {"step", "gravity", "solver", "solver_iterations", "solver_sor", "sleep_at_rest", "contact",
+                              "terrain", "obstacles", "lamps", "ambient_light"});
     YAML::Node scenario;
     YAML::Node sw;
-    for (const char* k : {"step", "gravity", "solver", "solver_iterations", "solver_sor", "contact", "terrain"})
+    sw["sleep_at_rest"] = false;  // the workbench's default (Dataset::world)
+    for (const char* k : {"step", "gravity", "solver", "solver_iterations", "solver_sor", "sleep_at_rest", "contact",
+                          "terrain"})
       if (w[k]) sw[k] = w[k];
     scenario["world"] = sw;
     try {

@@ -100,13 +100,24 @@ struct Run {
   std::size_t sampleCount() const;
 };
 
+/// The core's WorldConfig with sleeping at rest off (see Dataset::world).
+inline WorldConfig workbenchWorld() {
+  WorldConfig w;
+  w.rest.enabled = false;
+  return w;
+}
+
 struct Dataset {
   std::string dir;           ///< dataset directory
   std::string yaml_path;
   std::string name;
   std::string description;
   std::string robot = "medium";
-  WorldConfig world;         ///< terrain including the obstacles (as boxes with their surface labels)
+  /// Terrain including the obstacles (as boxes with their surface labels). Sleeping at rest
+  /// (RestConfig) is off unless the dataset's world says `sleep_at_rest: true`: a fit needs the
+  /// replay to be a smooth function of the effects' parameters, and sleep switches on a threshold
+  /// (with it a speed_scale + latency diagnosis settled on motor lag for one seed of two, 2026-12-01).
+  WorldConfig world = workbenchWorld();
   /// world.step / world.gravity written in the dataset: replays use them; otherwise the model
   /// level's recommended step and gravity (Fast: 0.1 s, 1/50 g).
   bool world_sets_step = false, world_sets_gravity = false;

@@ -489,6 +489,7 @@ void Robot::getTrackTorque(int* left, int* right) const {
 bool Robot::setTurretRotation(int pos) {
   const int range = description_->turret.range_units;
   const int p = clampInt(pos, -range, range);
+  if (p * description_->turret.unit != turret_target_) wake();
   turret_target_ = p * description_->turret.unit;
   return p != pos;
 }
@@ -634,6 +635,74 @@ void Robot::setBodyStates(const std::vector<BodyState>& states) {
     setBodyPose(bodies_[i], states[i].pose);
     dBodySetLinearVel(bodies_[i], states[i].linear.x(), states[i].linear.y(), states[i].linear.z());
     dBodySetAngularVel(bodies_[i], states[i].angular.x(), states[i].angular.y(), states[i].angular.z());
+    dBodyEnable(bodies_[i]);  // a sleeping robot moved by hand is awake (wakeIfDisturbed)
+  }
+}
+
+// ---- sleeping at rest ----------------------------------------------------------------------------
+
+void Robot::sleep() {
+  for (dBodyID b : bodies_) {
+    // At rest: what is left of the velocities is the solver's jitter, not motion.
+    dBodySetLinearVel(b, 0, 0, 0);
+    dBodySetAngularVel(b, 0, 0, 0);
+    dBodyDisable(b);
+  }
+  asleep_ = true;
+}
+
+void Robot::wake() {
+  for (dBodyID b : bodies_) dBodyEnable(b);
+  asleep_ = false;
+  rest_watch_.reset();
+  rest_window_ = -1;
+}
+
+void Robot::wakeIfDisturbed() {
+  if (!asleep_) return;
+  bool disturbed = false;
+  for (dBodyID b : bodies_) {
+    disturbed = disturbed || dBodyIsEnabled(b);
+    const dReal* f = dBodyGetForce(b);
+    const dReal* t = dBodyGetTorque(b);
+    for (int k = 0; k < 3; ++k) disturbed = disturbed || f[k] != 0 || t[k] != 0;
+  }
+  if (disturbed) wake();
+}
+
+void Robot::updateRest(const RestConfig& config) {
+  if (asleep_) {
+    if (dBodyIsEnabled(baseBody())) {
+      wake();  // ODE's island walk enabled it (and all it is jointed to): touched or held by an awake body
+    } else {
+      // The forces this robot's own command path added while it slept (rolling resistance, the
+      // body drive) were not applied; clear them so that only new, external ones wake it.
+      for (dBodyID b : bodies_) {
+        dBodySetForce(b, 0, 0, 0);
+        dBodySetTorque(b, 0, 0, 0);
+      }
+    }
+    return;
+  }
+  if (!config.enabled || !commanded_still_) {
+    rest_watch_.reset();
+    rest_window_ = -1;
+    return;
+  }
+  const bool still = rest_watch_.stoodStill(bodies_, world_.time(), config);
+  if (rest_watch_.windowStart() != rest_window_) {
+    rest_window_ = rest_watch_.windowStart();
+    rest_samples_ = 0;
+    rest_load_sum_ = 0;
+    rest_force_sum_ = Vec3::Zero();
+  }
+  ++rest_samples_;
+  rest_load_sum_ += drive_wheel_load_;
+  rest_force_sum_ += drive_contact_force_;
+  if (still) {
+    drive_wheel_load_ = rest_load_sum_ / rest_samples_;
+    drive_contact_force_ = rest_force_sum_ / rest_samples_;
+    sleep();
   }
 }
 
@@ -669,6 +738,10 @@ void Robot::applyCommands(double dt, const std::vector<EffectPtr>& effects) {
   }
   updateCreepSlip(cmd);  // once per step, for every terrain contact of the wheels that collision makes
   applyRollingResistance(cmd);
+  // Standing is the command after the effects: a motor-noise effect that moves a "stopped" track
+  // keeps the robot awake.
+  commanded_still_ = cmd.left == 0 && cmd.right == 0;
+  if (asleep_ && !commanded_still_) wake();
 
   if (turret_hinge_ >= 0) {
     // Position servo (the turret's PIC controller): proportional velocity demand capped at the

@@ -203,8 +203,8 @@ void parseTerrain(const YAML::Node& n, TerrainConfig& t, const std::string& file
 void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
   Fields f(n, "world", file);
   // lamps / ambient_light: the sensed environment, not physics (parseSensedEnvironment).
-  f.allowOnly({"step", "gravity", "solver", "solver_iterations", "solver_sor", "lock_idle_turret", "contact", "terrain",
-               "lamps", "ambient_light"});
+  f.allowOnly({"step", "gravity", "solver", "solver_iterations", "solver_sor", "lock_idle_turret", "sleep_at_rest",
+               "contact", "terrain", "lamps", "ambient_light"});
   w.solver = f.text("solver", w.solver);
   if (w.solver != "quickstep" && w.solver != "exact")
     throw ConfigError(file, f.path("solver"), "expected 'quickstep' or 'exact', found '" + w.solver + "'");
@@ -217,6 +217,7 @@ void parseWorld(const YAML::Node& n, WorldConfig& w, const std::string& file) {
   w.solver_iterations = static_cast<int>(f.integer("solver_iterations", w.solver_iterations, 1, 100000));
   w.solver_sor = f.within("solver_sor", w.solver_sor, 0.01, kMaxSolverSor);
   w.lock_idle_turret = f.flag("lock_idle_turret", w.lock_idle_turret);
+  w.rest.enabled = f.flag("sleep_at_rest", w.rest.enabled);
   if (const YAML::Node c = f.node("contact")) {
     Fields cf(c, "world.contact", file);
     cf.allowOnly({"mu", "erp", "cfm", "bounce", "max_contacts", "coulomb", "materials"});
@@ -450,6 +451,7 @@ std::string scenarioYaml(const Scenario& sc, const std::string& name, const std:
   e << YAML::Key << "solver_iterations" << YAML::Value << w.solver_iterations;
   e << YAML::Key << "solver_sor" << YAML::Value << num(w.solver_sor);
   e << YAML::Key << "lock_idle_turret" << YAML::Value << w.lock_idle_turret;
+  e << YAML::Key << "sleep_at_rest" << YAML::Value << w.rest.enabled;
   e << YAML::Key << "contact" << YAML::Value << YAML::BeginMap;
   e << YAML::Key << "mu" << YAML::Value << num(w.contact.mu);
   e << YAML::Key << "erp" << YAML::Value << num(w.contact.erp);

@@ -250,6 +250,7 @@ Robot& World::switchLevel(const std::string& name, const RobotDescription& descr
   Robot& r = robot(name);
   r.switchDescription(description);
   updateSolverIterations();
+  wakeAll();  // robots that touched or held the old model
   return r;
 }
 
@@ -267,6 +268,7 @@ void World::removeRobot(const std::string& name) {
   connections_->removeRobot(name);
   robots_.erase(it);
   updateSolverIterations();
+  wakeAll();  // robots that rested on it or against it
 }
 
 Robot* World::findRobot(const std::string& name) {
@@ -287,6 +289,11 @@ std::vector<Robot*> World::robots() {
   return out;
 }
 
+void World::wakeAll() {
+  for (auto& r : robots_)
+    if (r->asleep()) r->wake();
+}
+
 void World::enableProfile(bool on) {
   profiling_ = on;
   profile_ = StepProfile{};
@@ -304,6 +311,13 @@ void World::step() {
     mark = now;
   };
   const double dt = config_.step;
+  // A new gravity (a slope experiment tilts it) disturbs every robot.
+  dVector3 ode_g;
+  dWorldGetGravity(world_, ode_g);
+  const Vec3 g(ode_g[0], ode_g[1], ode_g[2]);
+  if (g != stepped_gravity_) wakeAll();
+  stepped_gravity_ = g;
+  for (auto& r : robots_) r->wakeIfDisturbed();
   for (auto& r : robots_) r->applyCommands(dt, effects_);
   lap(profile_.commands_s);
   dSpaceCollide(space_, this, &nearCallback);  // robot against robot
@@ -321,10 +335,11 @@ void World::step() {
   updateDriveWheelLoads();
   dJointGroupEmpty(contacts_);
   for (auto& r : robots_) r->readFeedback(dt);
-  lap(profile_.feedback_s);
-  ++profile_.steps;
   time_ += dt;
   ++steps_;
+  for (auto& r : robots_) r->updateRest(config_.rest);
+  lap(profile_.feedback_s);
+  ++profile_.steps;
 }
 
 namespace {
@@ -445,11 +460,13 @@ void World::handlePair(dGeomID a, dGeomID b) {
 }
 
 void World::updateDriveWheelLoads() {
-  for (auto& r : robots_) r->clearDriveContacts();
+  // A robot out of the solve keeps the loads it stood on (its contacts' feedback is not written).
+  for (auto& r : robots_)
+    if (dBodyIsEnabled(r->baseBody())) r->clearDriveContacts();
   auto add = [](Robot* r, const dVector3 force, double sign, const Vec3& normal, bool wheel) {
     const Vec3 f(force[0], force[1], force[2]);
     const double push = sign * f.dot(normal);
-    if (r && push > 0) r->addDriveContact(push, f, wheel);
+    if (r && push > 0 && dBodyIsEnabled(r->baseBody())) r->addDriveContact(push, f, wheel);
   };
   for (const WheelContact& w : wheel_contacts_) {
     // The contact normal points from geom 2 into geom 1: body 1 is pushed along it, body 2

@@ -124,6 +124,7 @@ TEST(Scenario, RefusesValuesThatWouldMisbehaveLater) {
   refused("world: {terrain: {type: composite, boxes: [{name: a, center: [1, 0, 0]}, {name: a, center: [2, 0, 0]}]}}",
           "'world.terrain.boxes[1].name': 'a' names another box too");
   refused("world: {gravity: 1e30}", "'world.gravity': must be <= 1000 m/s^2");
+  refused("world: {sleep_at_rest: sometimes}", "'world.sleep_at_rest': expected true or false");
   // Aborted inside ODE, or hung there (an outside probe, 2026-11-29, thirty-fifth session):
   // over-relaxation from 2 on diverges; a rough terrain of 1 cm took minutes a step, of 1e-300 m aborted.
   refused("world: {solver_sor: 3}", "'world.solver_sor': must be in [0.01, 1.99], found 3");
@@ -250,6 +251,7 @@ world:
   solver_iterations: 33
   solver_sor: 1.2
   lock_idle_turret: true
+  sleep_at_rest: false
   contact: {mu: 0.3, erp: 0.4, cfm: 2.0e-5, bounce: 0.1, max_contacts: 6, coulomb: false, materials: {track: 1.7, caster: 0.0}}
   terrain:
     type: composite
@@ -274,6 +276,8 @@ links: [{holder: holder, held: held, kind: side_arm}]
   EXPECT_EQ(b.world.solver_iterations, 33);
   EXPECT_DOUBLE_EQ(b.world.solver_sor, 1.2);
   EXPECT_TRUE(b.world.lock_idle_turret);
+  EXPECT_FALSE(b.world.rest.enabled);
+  EXPECT_TRUE(parseScenario("world: {}", "/abs/c.yaml").world.rest.enabled);  // on by default
   EXPECT_DOUBLE_EQ(b.world.contact.mu, 0.3);
   EXPECT_DOUBLE_EQ(b.world.contact.erp, 0.4);
   EXPECT_DOUBLE_EQ(b.world.contact.cfm, 2.0e-5);

@@ -15,6 +15,7 @@
 #include "sbot_sim/core/geom_info.h"
 #include "sbot_sim/core/link_ref.h"
 #include "sbot_sim/core/random_streams.h"
+#include "sbot_sim/core/rest.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/types.h"
 #include "sbot_sim/core/world_config.h"
@@ -177,6 +178,20 @@ class Robot {
   double trackCreepSlip(int track) const { return creep_slip_[track]; }
   dBodyID baseBody() const;
   dSpaceID space() const { return space_; }
+
+  // ---- sleeping at rest (RestConfig; World drives these once per step) -------------------------
+  /// True while the robot is out of the solve: it was commanded to stand (both tracks at zero
+  /// after the command-path effects) and stood still for RestConfig::window_s.
+  bool asleep() const { return asleep_; }
+  /// Before the step: wake a sleeping robot that something disturbed, i.e. whose bodies were
+  /// enabled (setBasePose, a rebuild) or carry a force or torque (an external push).
+  void wakeIfDisturbed();
+  /// After the step: a sleeping robot that ODE woke (a contact or joint with an awake body) is
+  /// awake again; an awake one commanded to stand that stood still for the window falls asleep.
+  void updateRest(const RestConfig& config);
+  /// Back into the solve, the rest window restarted. Every command that changes a target calls it
+  /// (a track speed through applyCommands, the turret, the gripper, the side arm).
+  void wake();
   const std::vector<dBodyID>& bodies() const { return bodies_; }
   std::size_t geomCount() const { return geoms_.size(); }
 
@@ -264,6 +279,16 @@ class Robot {
   double req_left_ = 0, req_right_ = 0;  ///< requested track speeds [m/s]
   double turret_target_ = 0;             ///< [rad]
   bool passive_ = false;
+  bool asleep_ = false;                  ///< see asleep()
+  bool commanded_still_ = false;         ///< both tracks commanded 0 in the last applyCommands
+  RestWatch rest_watch_;
+  // The drive-contact loads summed over the rest window: a sleeping robot keeps their mean (one
+  // step's quickstep loads scatter by +-25 % on a standing Basic).
+  double rest_window_ = -1;              ///< [s] RestWatch::windowStart() the sums belong to
+  int rest_samples_ = 0;
+  double rest_load_sum_ = 0;             ///< [N]
+  Vec3 rest_force_sum_ = Vec3::Zero();   ///< [N]
+  void sleep();
 
   // Body drive (sidecar treels.drive: body; the Fast level). In 1/50 g a 1/20-mass robot's wheel
   // contacts carry ~10 mN, too little for ODE's wheel contacts at 100 ms steps (the robot hops and

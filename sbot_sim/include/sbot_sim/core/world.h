@@ -113,9 +113,19 @@ class World {
   static constexpr double kPlacementTolerance = 0.01;  ///< [m] a robot set down slightly low settles
   std::string placeRobot(Robot& robot, const Pose& pose);
 
-  void addEffect(EffectPtr effect) { effects_.push_back(std::move(effect)); }
+  /// Effects change what robots feel: sleeping robots (Robot::asleep) are woken.
+  void addEffect(EffectPtr effect) {
+    effects_.push_back(std::move(effect));
+    wakeAll();
+  }
   const std::vector<EffectPtr>& effects() const { return effects_; }
-  void clearEffects() { effects_.clear(); }
+  void clearEffects() {
+    effects_.clear();
+    wakeAll();
+  }
+  /// Every sleeping robot back into the solve (world changes: gravity, effects, a robot removed
+  /// or switched).
+  void wakeAll();
 
   /// Gripper / side-arm connections between robots (actuators/connections.h).
   ConnectionManager& connections() { return *connections_; }
@@ -160,6 +170,7 @@ class World {
   mutable dGeomID query_box_ = nullptr;  ///< castRays' bounding box, also in no space
   mutable std::vector<BoxedGeom> ray_candidates_;  ///< castRays' geoms within that box (reused)
   int solver_iterations_ = 0;
+  Vec3 stepped_gravity_ = Vec3::Zero();  ///< [m/s^2] ODE's gravity at the last step (see step)
   bool exact_solver_ = false;     ///< config_.solver == "exact"
   void updateSolverIterations();  ///< after a robot came, went or changed level
   dGeomID queryRay(double length) const;  ///< query_ray_ with this length

@@ -81,6 +81,26 @@ struct TerrainConfig {
 /// Every surface label `terrain` uses: its boxes' and, with the ground plane, "ground".
 std::set<std::string> surfaceLabels(const TerrainConfig& terrain);
 
+/// Sleeping at rest (rest.h says why): a robot commanded to stand that stood still is taken out
+/// of the solve until something disturbs it.
+struct RestConfig {
+  /// Put robots to sleep at rest (scenario `world.sleep_at_rest`). Off: every robot is solved
+  /// every step, creep included (to study the solver itself).
+  bool enabled = true;
+  /// [s] how long a robot must have stood still, commanded to stand, before it sleeps.
+  double window_s = 0.5;
+  /// [m] no body of the robot moved further than this during the window (4 mm/s at 0.5 s: a
+  /// standing Simple creeps ~2 mm/s and rocks ~1 mm; a robot sliding or tipping for real
+  /// accelerates past it within the window).
+  double max_shift_m = 0.002;
+  /// [rad] no heavy body (see heavy_fraction) turned further than this during the window. Light
+  /// bodies (wheels, the Basic gripper element) are left out: a wheel held at zero speed jitters
+  /// a few degrees about its axle under quickstep while the robot stands.
+  double max_turn_rad = 0.035;
+  /// Bodies of at least this fraction of the robot's mass are "heavy" (chassis, turret).
+  double heavy_fraction = 0.1;
+};
+
 struct WorldConfig {
   double step = 0.01;          ///< fixed integration step [s], in [kMinStep, kMaxStep]
   double gravity = 9.81;       ///< [m/s^2], pointing -z
@@ -102,6 +122,7 @@ struct WorldConfig {
   /// and the gripper raised tilt 11 deg in an abrupt spin (hinge 4, exact solver 0.3) and toppled
   /// in the obstacle-avoidance scenario (README, "Yaw drift and the turret weld").
   bool lock_idle_turret = false;
+  RestConfig rest;
   std::uint64_t seed = 1;      ///< root of every random stream
   ContactConfig contact;
   TerrainConfig terrain;

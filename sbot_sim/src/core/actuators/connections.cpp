@@ -10,7 +10,12 @@ namespace sbot {
 ConnectionManager::~ConnectionManager() { clear(); }
 
 void ConnectionManager::destroy(Connection& c) {
-  if (c.joint) dJointDestroy(c.joint);
+  if (c.joint) {
+    // The robots it joined may be asleep (Robot::asleep): a held robot let go must fall.
+    for (int i = 0; i < 2; ++i)
+      if (dBodyID b = dJointGetBody(c.joint, i)) dBodyEnable(b);
+    dJointDestroy(c.joint);
+  }
   delete c.feedback;
   c.joint = nullptr;
   c.feedback = nullptr;
@@ -36,6 +41,8 @@ int ConnectionManager::connect(const std::string& holder, dBodyID holder_body, c
     const dReal* p = dBodyGetPosition(holder_body);
     dJointSetBallAnchor(c.joint, p[0], p[1], p[2]);
   }
+  dBodyEnable(holder_body);  // both robots back into the solve (Robot::wakeIfDisturbed)
+  dBodyEnable(held_body);
   c.feedback = new dJointFeedback{};
   dJointSetFeedback(c.joint, c.feedback);
   connections_.push_back(c);

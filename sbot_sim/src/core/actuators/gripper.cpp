@@ -85,12 +85,14 @@ const char* FrontGripper::typeName() const {
 
 bool FrontGripper::setElevation(int degrees) {
   const int v = std::clamp(degrees, kElevationMin, kElevationMax);
+  if (v != cmd_elevation_) robot_.wake();
   cmd_elevation_ = v;
   return v != degrees;
 }
 
 bool FrontGripper::setAperture(int degrees) {
   const int v = std::clamp(degrees, kApertureMin, kApertureMax);
+  robot_.wake();  // opening releases a grip, closing may take one: the robot is solved again
   cmd_aperture_ = v;
   if (v > 0) {
     closing_ = false;

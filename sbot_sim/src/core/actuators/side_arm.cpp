@@ -96,6 +96,7 @@ bool SideArm::setPos(int elevation, int rotation, int depth) {
   const int e = std::clamp(elevation, -elev_limit_units_, elev_limit_units_);
   const int r = std::clamp(rotation, -rot_limit_units_, rot_limit_units_);
   const int d = std::clamp(depth, depth_min_mm_, depth_max_mm_);
+  if (e != cmd_e_ || r != cmd_r_ || d != cmd_d_) robot_.wake();
   cmd_e_ = e;
   cmd_r_ = r;
   cmd_d_ = d;
@@ -124,6 +125,7 @@ void SideArm::getTorque(int* elevation, int* rotation, int* depth) const {
 
 void SideArm::setOpened() {
   if (!available_) return;
+  robot_.wake();
   closed_cmd_ = false;
   closing_ = false;
   world_.connections().release(robot_.name(), Connection::SideArm);
@@ -131,6 +133,7 @@ void SideArm::setOpened() {
 
 void SideArm::setClosed() {
   if (!available_) return;
+  robot_.wake();
   closed_cmd_ = true;
   closing_ = true;
   stall_.reset();

@@ -1,0 +1,145 @@
+// Sleeping at rest (rest.h): robots commanded to stand stop creeping, and everything that should
+// move them still does.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "sim_fixture.h"
+
+namespace sbot::test {
+namespace {
+
+double planarDistance(const Pose& a, const Pose& b) { return (a.position - b.position).head<2>().norm(); }
+
+class RestEveryLevel : public ::testing::TestWithParam<const char*> {};
+
+// Under quickstep a standing Simple slid 19 mm in 10 s, a Basic 14, a Medium 8 (README, "Creep at
+// rest"); asleep, it does not move at all.
+TEST_P(RestEveryLevel, AStandingRobotFallsAsleepAndStaysPut) {
+  World w(flatWorld(3));
+  Robot& r = w.addRobot(loadLevel(GetParam()), {0.1, -0.2, 2.5}, "sbot_0");
+  runFor(w, 4.0);
+  ASSERT_TRUE(r.asleep()) << GetParam() << " still awake after 4 s at setSpeed(0, 0)";
+  const Pose before = r.basePose();
+  runFor(w, 10.0);
+  EXPECT_TRUE(r.asleep());
+  EXPECT_LT(planarDistance(r.basePose(), before), 1e-6);
+  EXPECT_LT(r.basePose().orientation.angularDistance(before.orientation), 1e-6);
+  // It still stands on its wheels as it did (the loads of the last solved step are kept).
+  EXPECT_GT(r.driveWheelLoad(), 0.0);
+}
+
+TEST_P(RestEveryLevel, WithSleepOffItIsSolvedEveryStep) {
+  WorldConfig c = flatWorld(3);
+  c.rest.enabled = false;
+  World w(c);
+  Robot& r = w.addRobot(loadLevel(GetParam()), {0, 0, 0}, "sbot_0");
+  for (int i = 0; i < 40; ++i) {
+    runFor(w, 0.25);
+    ASSERT_FALSE(r.asleep());
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Levels, RestEveryLevel, ::testing::Values("fast", "simple", "basic", "medium", "detailed"));
+
+// Wakes on a track command and then drives exactly as a robot that never slept: the same speed.
+TEST(Rest, ASpeedCommandWakesItAndItDrivesAsBefore) {
+  auto speedAfterStart = [](bool sleep) {
+    WorldConfig c = flatWorld(5);
+    c.rest.enabled = sleep;
+    World w(c);
+    Robot& r = w.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_0");
+    runFor(w, 3.0);
+    EXPECT_EQ(r.asleep(), sleep);
+    r.setSpeed(30, 30);
+    runFor(w, 1.0);
+    EXPECT_FALSE(r.asleep());
+    const Pose a = r.basePose();
+    runFor(w, 2.0);
+    return planarDistance(r.basePose(), a) / 2.0;
+  };
+  const double slept = speedAfterStart(true), never = speedAfterStart(false);
+  EXPECT_NEAR(slept, 30 * 0.0028, 0.05 * 30 * 0.0028);
+  EXPECT_NEAR(slept, never, 0.02 * never);
+}
+
+// setSpeed(0, 0) sent every step (as controllers do) keeps it asleep; a turret command wakes it.
+TEST(Rest, RepeatedStopsKeepItAsleepATurretCommandWakesIt) {
+  World w(flatWorld());
+  Robot& r = w.addRobot(loadLevel("basic"), {0, 0, 0}, "sbot_0");
+  runFor(w, 3.0);
+  ASSERT_TRUE(r.asleep());
+  for (int i = 0; i < 100; ++i) {
+    r.setSpeed(0, 0);
+    r.setTurretRotation(0);
+    w.step();
+  }
+  EXPECT_TRUE(r.asleep());
+  r.setTurretRotation(45);  // 90 deg
+  EXPECT_FALSE(r.asleep());
+  runFor(w, 5.0);
+  EXPECT_NEAR(r.turretAngle(), M_PI / 2, 0.03);
+}
+
+// A robot driving into a sleeping one pushes it: ODE's island walk enables the bodies an awake
+// body touches, and the sleeping robot's own terrain contacts are there (collision still runs).
+TEST(Rest, ARobotDrivingIntoASleepingOnePushesIt) {
+  World w(flatWorld());
+  Robot& sleeper = w.addRobot(loadLevel("simple"), {0.3, 0, 0}, "sleeper");
+  Robot& pusher = w.addRobot(loadLevel("simple"), {0, 0, 0}, "pusher");
+  runFor(w, 3.0);
+  ASSERT_TRUE(sleeper.asleep());
+  const Pose before = sleeper.basePose();
+  pusher.setSpeed(40, 40);
+  runFor(w, 6.0);
+  EXPECT_GT(sleeper.basePose().position.x() - before.position.x(), 0.05);
+  // Pushed, not sunk: it stays on the floor.
+  EXPECT_NEAR(sleeper.basePose().position.z(), before.position.z(), 0.003);
+}
+
+// An external force (a user's push, the calibration workbench's pull) wakes it.
+TEST(Rest, AnExternalForceWakesIt) {
+  World w(flatWorld());
+  Robot& r = w.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_0");
+  runFor(w, 3.0);
+  ASSERT_TRUE(r.asleep());
+  const Pose before = r.basePose();
+  for (int i = 0; i < 100; ++i) {
+    dBodyAddForce(r.baseBody(), 0, 20.0, 0);  // sideways, above the treels' grip (mu 2 x 6.5 N)
+    w.step();
+  }
+  EXPECT_FALSE(r.asleep());
+  EXPECT_GT(planarDistance(r.basePose(), before), 0.01);
+}
+
+// Tilting gravity (the slope experiments do) wakes it, and a robot that slides never falls asleep.
+TEST(Rest, TiltedGravityWakesItAndASlidingRobotStaysAwake) {
+  World w(flatWorld());
+  Robot& r = w.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_0");
+  runFor(w, 3.0);
+  ASSERT_TRUE(r.asleep());
+  const Pose before = r.basePose();
+  const double g = w.config().gravity, a = 50 * M_PI / 180;  // past its 31 deg sliding angle
+  dWorldSetGravity(w.odeWorld(), -g * std::sin(a), 0, -g * std::cos(a));
+  for (int i = 0; i < 20; ++i) {
+    runFor(w, 0.1);
+    EXPECT_FALSE(r.asleep()) << "at " << w.time() << " s";
+  }
+  EXPECT_LT(r.basePose().position.x() - before.position.x(), -0.05);
+}
+
+// Moving a sleeping robot by hand (setBasePose, the scenario tools) wakes it: it falls back down.
+TEST(Rest, TeleportingASleepingRobotWakesIt) {
+  World w(flatWorld());
+  Robot& r = w.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_0");
+  runFor(w, 3.0);
+  ASSERT_TRUE(r.asleep());
+  Pose up = r.basePose();
+  up.position.z() += 0.05;
+  r.setBasePose(up);
+  runFor(w, 1.0);
+  EXPECT_LT(r.basePose().position.z(), up.position.z() - 0.04);  // it fell back onto the floor
+}
+
+}  // namespace
+}  // namespace sbot::test
