@@ -89,14 +89,14 @@ struct RestConfig {
   bool enabled = true;
   /// [s] how long a robot must have stood still, commanded to stand, before it sleeps.
   double window_s = 0.5;
-  /// [m] no body of the robot moved further than this during the window (4 mm/s at 0.5 s: a
-  /// standing Simple creeps ~2 mm/s and rocks ~1 mm; a robot sliding or tipping for real
-  /// accelerates past it within the window).
-  double max_shift_m = 0.002;
-  /// [rad] no heavy body (see heavy_fraction) turned further than this during the window. Light
-  /// bodies (wheels, the Basic gripper element) are left out: a wheel held at zero speed jitters
-  /// a few degrees about its axle under quickstep while the robot stands.
-  double max_turn_rad = 0.035;
+  /// [m] no body of the robot moved further than this during the window (6 mm/s at 0.5 s: a
+  /// standing Simple creeps ~2 mm/s and rocks ~1 mm; at 2 mm one Simple in 20 took 7 s to settle).
+  /// A robot sliding or tipping for real accelerates past it within the window.
+  double max_shift_m = 0.003;
+  /// [rad] no heavy body (see heavy_fraction) turned further than this during the window (a
+  /// standing Simple rocks +-1.3 deg). Light bodies (wheels, the Basic gripper element) are left
+  /// out: a wheel held at zero speed jitters a few degrees about its axle under quickstep.
+  double max_turn_rad = 0.052;
   /// Bodies of at least this fraction of the robot's mass are "heavy" (chassis, turret).
   double heavy_fraction = 0.1;
 };
