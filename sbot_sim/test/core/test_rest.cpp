@@ -108,12 +108,21 @@ TEST(Rest, ARobotDrivingIntoASleepingOnePushesIt) {
   EXPECT_NEAR(sleeper.basePose().position.z(), before.position.z(), 0.003);
 }
 
+// One Simple on the flat floor, asleep after 3 s of standing.
+class SleepingSimple : public ::testing::Test {
+ protected:
+  void SetUp() override { ASSERT_TRUE(r.asleep()); }
+  static Robot& standFor3s(World& world) {
+    Robot& robot = world.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_0");
+    runFor(world, 3.0);
+    return robot;
+  }
+  World w{flatWorld()};
+  Robot& r = standFor3s(w);
+};
+
 // An external force (a user's push, the calibration workbench's pull) wakes it.
-TEST(Rest, AnExternalForceWakesIt) {
-  World w(flatWorld());
-  Robot& r = w.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_0");
-  runFor(w, 3.0);
-  ASSERT_TRUE(r.asleep());
+TEST_F(SleepingSimple, AnExternalForceWakesIt) {
   const Pose before = r.basePose();
   for (int i = 0; i < 100; ++i) {
     dBodyAddForce(r.baseBody(), 0, 20.0, 0);  // sideways, above the treels' grip (mu 2 x 6.5 N)
@@ -124,11 +133,7 @@ TEST(Rest, AnExternalForceWakesIt) {
 }
 
 // Tilting gravity (the slope experiments do) wakes it, and a robot that slides never falls asleep.
-TEST(Rest, TiltedGravityWakesItAndASlidingRobotStaysAwake) {
-  World w(flatWorld());
-  Robot& r = w.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_0");
-  runFor(w, 3.0);
-  ASSERT_TRUE(r.asleep());
+TEST_F(SleepingSimple, TiltedGravityWakesItAndASlidingRobotStaysAwake) {
   const Pose before = r.basePose();
   const double g = w.config().gravity, a = 50 * M_PI / 180;  // past its 31 deg sliding angle
   dWorldSetGravity(w.odeWorld(), -g * std::sin(a), 0, -g * std::cos(a));
@@ -140,11 +145,7 @@ TEST(Rest, TiltedGravityWakesItAndASlidingRobotStaysAwake) {
 }
 
 // Moving a sleeping robot by hand (setBasePose, the scenario tools) wakes it: it falls back down.
-TEST(Rest, TeleportingASleepingRobotWakesIt) {
-  World w(flatWorld());
-  Robot& r = w.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_0");
-  runFor(w, 3.0);
-  ASSERT_TRUE(r.asleep());
+TEST_F(SleepingSimple, TeleportingASleepingRobotWakesIt) {
   Pose up = r.basePose();
   up.position.z() += 0.05;
   r.setBasePose(up);
