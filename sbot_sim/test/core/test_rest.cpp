@@ -144,6 +144,22 @@ TEST_F(SleepingSimple, TiltedGravityWakesItAndASlidingRobotStaysAwake) {
   EXPECT_LT(r.basePose().position.x() - before.position.x(), -0.05);
 }
 
+// Standing on a 20 deg slope its motors hold it and it sleeps; released (passive treels: only the
+// gears' 1.2 N back-drive friction against 2.2 N downhill) it must roll down.
+TEST(Rest, ReleasingTheTracksOfARobotAsleepOnASlopeLetsItRoll) {
+  World w(flatWorld());
+  const double g = w.config().gravity, a = 20 * M_PI / 180;
+  dWorldSetGravity(w.odeWorld(), -g * std::sin(a), 0, -g * std::cos(a));
+  Robot& r = w.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_0");  // facing uphill: downhill is -x
+  runFor(w, 3.0);
+  ASSERT_TRUE(r.asleep());
+  const Pose before = r.basePose();
+  r.setTracksPassive(true);
+  runFor(w, 2.0);
+  EXPECT_FALSE(r.asleep());
+  EXPECT_LT(r.basePose().position.x() - before.position.x(), -0.05);
+}
+
 // Moving a sleeping robot by hand (setBasePose, the scenario tools) wakes it: it falls back down.
 TEST_F(SleepingSimple, TeleportingASleepingRobotWakesIt) {
   Pose up = r.basePose();

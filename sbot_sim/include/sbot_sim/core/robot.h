@@ -59,7 +59,10 @@ class Robot {
   double trackWidth() const { return track_width_; }
   /// Passive treels (seed TreelsModule::setPassive): motors off, only the gear back-drive friction
   /// (treels.backdrive_force) resists rolling. Any setSpeed() makes them active again.
-  void setTracksPassive(bool passive) { passive_ = passive; }
+  void setTracksPassive(bool passive) {
+    if (passive != passive_) wake();  // on a slope, released gears roll
+    passive_ = passive;
+  }
   bool tracksPassive() const { return passive_; }
   /// Turret position target in API units of 2 degrees, clamped to [-100,100]. Returns true if clamped.
   bool setTurretRotation(int pos);
