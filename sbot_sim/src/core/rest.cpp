@@ -22,6 +22,9 @@ void RestWatch::start(const std::vector<dBodyID>& bodies, double now_s) {
   orientations_.clear();
   masses_.clear();
   total_mass_ = 0;
+  samples_ = 0;
+  load_sum_ = 0;
+  force_sum_ = Vec3::Zero();
   for (dBodyID b : bodies) {
     positions_.push_back(positionOf(b));
     orientations_.push_back(orientationOf(b));

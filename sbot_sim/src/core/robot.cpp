@@ -655,19 +655,17 @@ void Robot::wake() {
   for (dBodyID b : bodies_) dBodyEnable(b);
   asleep_ = false;
   rest_watch_.reset();
-  rest_window_ = -1;
 }
 
 void Robot::wakeIfDisturbed() {
   if (!asleep_) return;
-  bool disturbed = false;
+  auto nonzero = [](const dReal* v) { return v[0] != 0 || v[1] != 0 || v[2] != 0; };
   for (dBodyID b : bodies_) {
-    disturbed = disturbed || dBodyIsEnabled(b);
-    const dReal* f = dBodyGetForce(b);
-    const dReal* t = dBodyGetTorque(b);
-    for (int k = 0; k < 3; ++k) disturbed = disturbed || f[k] != 0 || t[k] != 0;
+    if (dBodyIsEnabled(b) || nonzero(dBodyGetForce(b)) || nonzero(dBodyGetTorque(b))) {
+      wake();
+      return;
+    }
   }
-  if (disturbed) wake();
 }
 
 void Robot::updateRest(const RestConfig& config) {
@@ -686,22 +684,13 @@ void Robot::updateRest(const RestConfig& config) {
   }
   if (!config.enabled || !commanded_still_) {
     rest_watch_.reset();
-    rest_window_ = -1;
     return;
   }
   const bool still = rest_watch_.stoodStill(bodies_, world_.time(), config);
-  if (rest_watch_.windowStart() != rest_window_) {
-    rest_window_ = rest_watch_.windowStart();
-    rest_samples_ = 0;
-    rest_load_sum_ = 0;
-    rest_force_sum_ = Vec3::Zero();
-  }
-  ++rest_samples_;
-  rest_load_sum_ += drive_wheel_load_;
-  rest_force_sum_ += drive_contact_force_;
+  rest_watch_.addLoad(drive_wheel_load_, drive_contact_force_);
   if (still) {
-    drive_wheel_load_ = rest_load_sum_ / rest_samples_;
-    drive_contact_force_ = rest_force_sum_ / rest_samples_;
+    drive_wheel_load_ = rest_watch_.meanLoad();
+    drive_contact_force_ = rest_watch_.meanForce();
     sleep();
   }
 }

@@ -170,8 +170,8 @@ TEST(DriveEffects, LatencyDelaysTheStart) {
 
 TEST(DriveEffects, DeadBandSwallowsSmallCommands) {
   const std::vector<EffectConfig> band{{"dead_band", {{"threshold", 0.03}}, {}, ""}};
-  // Below the band the robot does what it does standing (quickstep lets a standing Simple creep
-  // ~2 mm per second sideways); 8 units undamped would take it 4.4 cm.
+  // Below the band the robot does what it does standing (quickstep's creep, until it sleeps at
+  // rest); 8 units undamped would take it 4.4 cm.
   EXPECT_NEAR(distance(drive(band, 8, 8, 2.0)), distance(drive({}, 0, 0, 2.0)), 0.001)
       << "8 units = 2.2 cm/s is below a 3 cm/s dead-band";
   const double d = distance(drive(band, 50, 50, 2.0)), d0 = distance(drive({}, 50, 50, 2.0));

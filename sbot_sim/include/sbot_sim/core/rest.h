@@ -20,7 +20,9 @@
 
 namespace sbot {
 
-/// Watches one robot's bodies for rest over RestConfig::window_s.
+/// Watches one robot's bodies for rest over RestConfig::window_s, and averages its drive-contact
+/// loads over the same window (a sleeping robot keeps their mean: one step's quickstep loads
+/// scatter by +-25 % on a standing Basic).
 class RestWatch {
  public:
   /// The next stoodStill() starts a new window (cheap: called every step a robot moves).
@@ -29,8 +31,14 @@ class RestWatch {
   /// none) and start a new one if any moved beyond the limits. True when they stayed within them
   /// for the whole window.
   bool stoodStill(const std::vector<dBodyID>& bodies, double now_s, const RestConfig& config);
-  /// [s] when the current window began (changes whenever stoodStill starts a new one).
-  double windowStart() const { return since_s_; }
+  /// One step's drive-contact load [N] and force [N], added to the current window's means.
+  void addLoad(double load, const Vec3& force) {
+    ++samples_;
+    load_sum_ += load;
+    force_sum_ += force;
+  }
+  double meanLoad() const { return samples_ ? load_sum_ / samples_ : 0.0; }
+  Vec3 meanForce() const { return samples_ ? Vec3(force_sum_ / samples_) : Vec3::Zero(); }
 
  private:
   void start(const std::vector<dBodyID>& bodies, double now_s);
@@ -40,6 +48,9 @@ class RestWatch {
   std::vector<Quat> orientations_;
   std::vector<double> masses_;  ///< [kg] per body
   double total_mass_ = 0;      ///< [kg]
+  int samples_ = 0;
+  double load_sum_ = 0;         ///< [N]
+  Vec3 force_sum_ = Vec3::Zero();  ///< [N]
 };
 
 }  // namespace sbot

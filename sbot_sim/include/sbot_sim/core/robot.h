@@ -285,12 +285,6 @@ class Robot {
   bool asleep_ = false;                  ///< see asleep()
   bool commanded_still_ = false;         ///< both tracks commanded 0 in the last applyCommands
   RestWatch rest_watch_;
-  // The drive-contact loads summed over the rest window: a sleeping robot keeps their mean (one
-  // step's quickstep loads scatter by +-25 % on a standing Basic).
-  double rest_window_ = -1;              ///< [s] RestWatch::windowStart() the sums belong to
-  int rest_samples_ = 0;
-  double rest_load_sum_ = 0;             ///< [N]
-  Vec3 rest_force_sum_ = Vec3::Zero();   ///< [N]
   void sleep();
 
   // Body drive (sidecar treels.drive: body; the Fast level). In 1/50 g a 1/20-mass robot's wheel
