@@ -2,10 +2,14 @@
 """Run validation sections on variants of the s-bot parameter table (a tuning aid).
 
     sweep_description.py [--set PATH=VALUE ...] [--grid PATH=V1,V2,... ...]
+                         [--sample N --range PATH=LO:HI ... [--seed S]]
                          [--only 4.1,4.2,4.3] [--trials 3] [--keep DIR] [--tables YAML]
 
 Each variant is the table (sbot_description/config/sbot_parameters.yaml) with the --set values and
-one combination of the --grid values applied. Its URDFs and sidecars are generated into a directory
+one combination of the --grid values applied. With --sample N there are N variants instead, each
+drawing every --range PATH uniformly from [LO, HI] (a random search over many parameters, where a
+grid would be too large; --seed makes the draw repeatable), and the best variants are listed at the
+end by the cells they match. Its URDFs and sidecars are generated into a directory
 of their own, and `sbot_validate` runs the sections on them through $SBOT_DESCRIPTION_DIR, so the
 source tree is never touched. One line per variant: the cells matched per group and the mismatched
 cells. --tables runs your own reference tables (sbot_validate --tables; src/validation/README.md)
@@ -26,6 +30,7 @@ import argparse
 import filecmp
 import itertools
 import os
+import random
 import re
 import shutil
 import subprocess
@@ -105,6 +110,26 @@ def parse_assignment(text, many):
 SHORT_NAMES = {"Hardware cells of Tables 4.1-4.3": "hardware", "Table 4.5 cells": "4.5", "Table 4.6 cells": "4.6"}
 
 
+def parse_range(text):
+    """'PATH=LO:HI' -> (PATH, (LO, HI)), refused unless LO < HI are numbers."""
+    if "=" not in text or ":" not in text.split("=", 1)[1]:
+        raise ValueError("--range expects PATH=LO:HI, found '%s'" % text)
+    path, bounds = text.split("=", 1)
+    try:
+        lo, hi = (float(b) for b in bounds.split(":"))
+    except ValueError:
+        raise ValueError("--range %s: LO and HI must be numbers, found '%s'" % (path, bounds))
+    if not lo < hi:
+        raise ValueError("--range %s: expected LO < HI, found %g:%g" % (path, lo, hi))
+    path_steps(path)
+    return path.strip(), (lo, hi)
+
+
+def matched_cells(tally):
+    """'hardware 14/16, 4.5 20/28' -> 34 (for ranking variants); 0 for an error message."""
+    return sum(int(n) for n in re.findall(r" (\d+)/\d+", tally))
+
+
 def summary(report_md):
     """'hardware 12/16, 4.5 21/28, ...' (every group the report tallies) and its mismatched rows."""
     with open(report_md, encoding="utf-8") as fh:
@@ -169,6 +194,9 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--set", action="append", default=[], metavar="PATH=VALUE")
     ap.add_argument("--grid", action="append", default=[], metavar="PATH=V1,V2,...")
+    ap.add_argument("--range", action="append", default=[], metavar="PATH=LO:HI")
+    ap.add_argument("--sample", type=int, default=0, metavar="N", help="N random variants over the --range paths")
+    ap.add_argument("--seed", type=int, default=1, help="seed of the --sample draw (default 1)")
     ap.add_argument("--only", help="sbot_validate sections (default 4.1,4.2,4.3; with --tables: all)")
     ap.add_argument("--tables", help="reference tables for sbot_validate (default: the seed's)")
     ap.add_argument("--trials", type=int, default=3, help="trials per cell (default 3)")
@@ -176,6 +204,11 @@ def main():
     a = ap.parse_args()
     if a.trials < 1:
         ap.error("--trials expects a whole number >= 1, found %d" % a.trials)
+    if bool(a.sample) != bool(a.range) or a.sample < 0:
+        ap.error("--sample N (N >= 1) and --range PATH=LO:HI go together, found --sample %d with %d range(s)"
+                 % (a.sample, len(a.range)))
+    if a.sample and a.grid:
+        ap.error("--grid and --sample are two ways of choosing variants: give one")
     if a.tables:
         if not os.path.isfile(a.tables):
             ap.error("--tables: %s is not a file" % a.tables)
@@ -185,13 +218,14 @@ def main():
     try:
         fixed = [parse_assignment(s, False) for s in a.set]
         grid = [parse_assignment(g, True) for g in a.grid]
+        ranges = [parse_range(r) for r in a.range]
         with open(TABLE, encoding="utf-8") as fh:
             own = unshared(yaml.safe_load(fh))  # the table as it is, to tell variants that change nothing
         base = unshared(own)
         for path, (value,) in fixed:
             set_value(base, path, value)
         # Validate every grid path once before running anything.
-        for path, values in grid:
+        for path, values in grid + [(p, [lo]) for p, (lo, _) in ranges]:
             set_value(unshared(base), path, values[0])
     except (OSError, ValueError, yaml.YAMLError) as e:
         print("sweep_description: %s" % e, file=sys.stderr)
@@ -205,7 +239,13 @@ def main():
     if error:
         print("sweep_description: the table itself: %s" % error, file=sys.stderr)
         return 2
-    combos = list(itertools.product(*[values for _, values in grid])) or [()]
+    if ranges:
+        rng = random.Random(a.seed)
+        grid = [(path, None) for path, _ in ranges]
+        combos = [tuple(round(rng.uniform(lo, hi), 6) for _, (lo, hi) in ranges) for _ in range(a.sample)]
+    else:
+        combos = list(itertools.product(*[values for _, values in grid])) or [()]
+    ranked = []
     print("%d variant(s); sections %s%s, %d trial(s) per cell; files in %s"
           % (len(combos), a.only or "all", " of " + a.tables if a.tables else "", a.trials, root))
     for n, combo in enumerate(combos):
@@ -216,9 +256,14 @@ def main():
         tally, missed = run_variant(table, a.only, a.trials, os.path.join(root, "variant_%03d" % n),
                                     os.path.join(baseline, "urdf") if table != own else None, a.tables)
         print("%s: %s" % (label, tally))
+        ranked.append((matched_cells(tally), n, label, tally))
         for m in missed:
             print("    mismatch: %s" % m)
         sys.stdout.flush()
+    if ranges:
+        print("best variants (cells matched, variant):")
+        for cells, n, label, tally in sorted(ranked, key=lambda r: (-r[0], r[1]))[:5]:
+            print("  %s  variant_%03d: %s" % (tally, n, label))
     if not a.keep:
         shutil.rmtree(root, ignore_errors=True)
     return 0

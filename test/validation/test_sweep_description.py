@@ -80,6 +80,41 @@ class SweepDescription(unittest.TestCase):
         self.assertEqual(r.returncode, 2)
         self.assertIn("element [9] does not exist", r.stderr)
 
+    def test_a_random_sample_draws_each_path_within_its_range_repeatably(self):
+        args = ("--sample", "2", "--seed", "7", "--range", "levels.detailed.turret.com_m[0]=0.031:0.032",
+                "--only", "4.2", "--trials", "1")
+        keep = tempfile.mkdtemp(prefix="sweep_test_")
+        r = sweep(*(args + ("--keep", keep)))
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("2 variant(s)", r.stdout)
+        drawn = [float(x) for x in re.findall(r"com_m\[0\]=([0-9.]+): hardware \d+/3", r.stdout)]
+        self.assertEqual(len(drawn), 2, r.stdout)
+        for n, x in enumerate(drawn):
+            self.assertTrue(0.031 <= x <= 0.032, "drawn %g outside the range" % x)
+            with open(os.path.join(keep, "variant_%03d" % n, "urdf", "detailed.urdf"), encoding="utf-8") as fh:
+                urdf = fh.read()
+            turret = urdf[urdf.index('<link name="turret">'):]
+            self.assertRegex(turret[:400], r'<origin xyz="%s 0 ' % re.escape("%g" % x))
+        self.assertNotEqual(drawn[0], drawn[1])
+        self.assertIn("best variants", r.stdout)
+        # The same seed draws the same variants.
+        again = [float(x) for x in re.findall(r"com_m\[0\]=([0-9.]+):", sweep(*args).stdout)]
+        self.assertEqual(again, drawn)
+
+    def test_a_malformed_sample_is_refused_by_name(self):
+        r = sweep("--sample", "3", "--range", "levels.detailed.turret.com_m[0]=0.05:0.01")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("expected LO < HI", r.stderr)
+        r = sweep("--sample", "3", "--range", "levels.detailed.turret.com_m[0]=0.01")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("PATH=LO:HI", r.stderr)
+        r = sweep("--sample", "3")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("go together", r.stderr)
+        r = sweep("--sample", "3", "--range", "levels.detailed.turet.com_m[0]=0.01:0.02")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("'turet' is not in the table", r.stderr)
+
 
 if __name__ == "__main__":
     unittest.main(argv=[sys.argv[0], "-v"])
