@@ -2,8 +2,10 @@
 // move them still does.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
+#include "sbot_sim/core/actuators/connections.h"
 #include "sim_fixture.h"
 
 namespace sbot::test {
@@ -92,9 +94,10 @@ TEST(Rest, RepeatedStopsKeepItAsleepATurretCommandWakesIt) {
   EXPECT_NEAR(r.turretAngle(), M_PI / 2, 0.03);
 }
 
-// A robot driving into a sleeping one pushes it: ODE's island walk enables the bodies an awake
-// body touches, and the sleeping robot's own terrain contacts are there (collision still runs).
-TEST(Rest, ARobotDrivingIntoASleepingOnePushesIt) {
+// A robot driving into a sleeping one pushes it. A sleeper's terrain contacts are not made, so the
+// world wakes it as soon as the pusher's contact is made, before the terrain is collided: woken
+// later (by ODE's island walk, mid-step) it would be solved for a step without its floor and drop.
+TEST(Rest, ARobotDrivingIntoASleepingOnePushesItWithoutDroppingIt) {
   World w(flatWorld());
   Robot& sleeper = w.addRobot(loadLevel("simple"), {0.3, 0, 0}, "sleeper");
   Robot& pusher = w.addRobot(loadLevel("simple"), {0, 0, 0}, "pusher");
@@ -102,10 +105,45 @@ TEST(Rest, ARobotDrivingIntoASleepingOnePushesIt) {
   ASSERT_TRUE(sleeper.asleep());
   const Pose before = sleeper.basePose();
   pusher.setSpeed(40, 40);
-  runFor(w, 6.0);
+  double fastest_fall = 0, lowest = before.position.z();
+  for (int i = 0; i < 600; ++i) {
+    w.step();
+    fastest_fall = std::max(fastest_fall, -dBodyGetLinearVel(sleeper.baseBody())[2]);
+    lowest = std::min(lowest, sleeper.basePose().position.z());
+  }
   EXPECT_GT(sleeper.basePose().position.x() - before.position.x(), 0.05);
-  // Pushed, not sunk: it stays on the floor.
+  // Pushed, not dropped: one step without its floor is g dt = 0.098 m/s downward.
+  EXPECT_LT(fastest_fall, 0.03) << "the sleeper fell when it was woken";
+  EXPECT_GT(lowest, before.position.z() - 0.001);
   EXPECT_NEAR(sleeper.basePose().position.z(), before.position.z(), 0.003);
+}
+
+// A chain of three robots, each holding the next (fixed joints, as the front gripper's), asleep
+// together. When the first drives, the joints wake the others link by link before the terrain is
+// collided, so none of them is solved a step without its floor.
+TEST(Rest, ASleepingChainWakesLinkByLinkWithoutDropping) {
+  World w(flatWorld());
+  std::vector<Robot*> chain;
+  for (int i = 0; i < 3; ++i)
+    chain.push_back(&w.addRobot(loadLevel("simple"), {-0.16 * i, 0, 0}, "sbot_" + std::to_string(i)));
+  for (int i = 0; i + 1 < 3; ++i)
+    w.connections().connect(chain[i]->name(), chain[i]->baseBody(), chain[i + 1]->name(), chain[i + 1]->baseBody(),
+                            Connection::FrontGripper);
+  runFor(w, 3.0);
+  for (const Robot* r : chain) ASSERT_TRUE(r->asleep()) << r->name();
+  const double z0 = chain[2]->basePose().position.z(), x0 = chain[2]->basePose().position.x();
+  chain[0]->setSpeed(30, 30);
+  double fastest_fall = 0;
+  for (int i = 0; i < 300; ++i) {
+    w.step();
+    for (const Robot* r : chain) {
+      EXPECT_FALSE(r->asleep()) << r->name() << " asleep at step " << i;
+      fastest_fall = std::max(fastest_fall, -dBodyGetLinearVel(r->baseBody())[2]);
+    }
+  }
+  EXPECT_LT(fastest_fall, 0.03) << "a woken link fell";
+  EXPECT_GT(chain[2]->basePose().position.x() - x0, 0.01) << "the last link was towed";
+  EXPECT_NEAR(chain[2]->basePose().position.z(), z0, 0.003);
 }
 
 // One Simple on the flat floor, asleep after 3 s of standing.

@@ -157,6 +157,10 @@ class World {
   void indexTerrain();  ///< fills terrain_index_ (after buildTerrain)
   /// Contacts between a robot and the terrain (see world.cpp for why not dSpaceCollide2).
   void collideWithTerrain(Robot& r);
+  /// Before the terrain is collided: wake every sleeping robot that a joint (a contact made this
+  /// step, a connection, a static link) ties to an awake body, as ODE's island walk would mid-step.
+  void wakeSleepersJointedToAwakeBodies();
+  bool jointedToAnEnabledBody(const Robot& robot) const;
   Robot* robotOwning(dGeomID g) const;
   const std::string& materialOf(dGeomID g) const;
 
