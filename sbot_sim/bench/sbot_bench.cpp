@@ -1,7 +1,7 @@
 // sbot_bench: how fast the headless core simulates swarms. Not a test: it prints figures.
 //
-//   sbot_bench [--level simple] [--robots 1,10,100] [--seconds 20] [--step 0.01] [--chains K] [--profile]
-//   sbot_bench --scenario FILE [--robots N,...] [--seconds 20] [--profile]
+//   sbot_bench [--level simple] [--robots 1,10,100] [--seconds 20] [--step 0.01] [--chains K] [--idle] [--profile]
+//   sbot_bench --scenario FILE [--robots N,...] [--seconds 20] [--idle] [--profile]
 //
 // --chains K: the robots form chains of K connected by static front-gripper links (robot i+1 grips
 // robot i; core/swarm/swarm_graph.h), each chain driving one random-walk command, and the swarm graph
@@ -10,6 +10,9 @@
 // links and effects (core/scenario_world.h, as the simulator node builds it), every robot on the same
 // random walk; --robots then overrides its swarm.count, one row per number. Its step and levels are
 // the scenario's (--level, --step and --chains are refused with it).
+// --idle: the robots stand (setSpeed(0, 0)) instead of walking. They get 3 simulated seconds,
+// untimed, to settle and fall asleep (sleeping at rest, on unless the scenario's world turns it
+// off); then --seconds are timed, and the row says how many are asleep at the end.
 // --profile: also print where the step time goes (World::enableProfile): solver, collision
 // detection, motor commands, feedback, and the contact joints per step.
 //
@@ -46,13 +49,14 @@ struct Options {
   double step = 0;  // 0: the level's recommended step
   int chains = 0;   // robots per chain, 0 = unconnected
   bool profile = false;
+  bool idle = false;  // stand instead of the random walk (after an untimed settling)
   std::string scenario;  // a scenario file instead of the arena ("": the arena)
   bool robots_given = false;
 };
 
 constexpr const char* kUsage =
-    "usage: sbot_bench [--level L] [--robots 1,10,100] [--seconds S] [--step DT] [--chains K] [--profile]\n"
-    "       sbot_bench --scenario FILE [--robots N,...] [--seconds S] [--profile]\n";
+    "usage: sbot_bench [--level L] [--robots 1,10,100] [--seconds S] [--step DT] [--chains K] [--idle] [--profile]\n"
+    "       sbot_bench --scenario FILE [--robots N,...] [--seconds S] [--idle] [--profile]\n";
 
 Options parse(int argc, char** argv) {
   // Values are checked (atoi/atof turned "--robots 0" or "--seconds -1" into a row of nonsense).
@@ -68,6 +72,7 @@ Options parse(int argc, char** argv) {
     else if (a == "--step") o.step = args.number(sbot::kMinStep, sbot::kMaxStep);
     else if (a == "--chains") o.chains = args.count(0, sbot::kMaxRobots);
     else if (a == "--profile") o.profile = true;
+    else if (a == "--idle") o.idle = true;
     else if (a == "--robots") {
       o.robots_given = true;
       o.robots.clear();
@@ -139,7 +144,7 @@ std::string levelsOf(sbot::World& w) {
 }
 
 /// One row: `n` robots (--scenario: its swarm.count overridden, or its own robots for n < 0) on a
-/// random walk for --seconds, in this process.
+/// random walk (or standing, --idle) for --seconds, in this process.
 void runOne(const Options& o, int n) {
   const bool scenario = !o.scenario.empty();
   std::unique_ptr<sbot::World> world =
@@ -152,10 +157,12 @@ void runOne(const Options& o, int n) {
   std::size_t components = 0;
   const int steps = static_cast<int>(o.seconds / c.step);
   const int change_every = static_cast<int>(1.0 / c.step);  // new random command every simulated second
+  constexpr double kIdleSettle = 3.0;  // [s] standing robots are all asleep well within it (core_test_rest)
+  if (o.idle) w.stepN(static_cast<int>(kIdleSettle / c.step));
   w.enableProfile(o.profile);
   const auto t0 = std::chrono::steady_clock::now();
   for (int s = 0; s < steps; ++s) {
-    if (s % change_every == 0) {
+    if (!o.idle && s % change_every == 0) {
       const std::vector<sbot::Robot*> robots = w.robots();
       for (std::size_t i = 0; i < robots.size(); ++i) {
         sbot::Robot* r = robots[i];
@@ -172,12 +179,18 @@ void runOne(const Options& o, int n) {
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
-  std::printf("%-8s %7zu %10.1f %12.1f %14.3f %12.1f", levelsOf(w).c_str(), w.robotCount(), w.time(), w.time() / wall,
+  const double timed_s = steps * c.step;
+  std::printf("%-8s %7zu %10.1f %12.1f %14.3f %12.1f", levelsOf(w).c_str(), w.robotCount(), timed_s, timed_s / wall,
               1000.0 * wall / steps, ru.ru_maxrss / 1024.0);
+  if (o.idle) {
+    int asleep = 0;
+    for (const sbot::Robot* r : w.robots()) asleep += r->asleep();
+    std::printf("   idle, %d asleep at the end (after %.0f s untimed to settle)", asleep, kIdleSettle);
+  }
   if (o.chains > 0) {
     // CPU-time RTM too: on a shared machine the wall clock includes waiting for a core.
     const double cpu = ru.ru_utime.tv_sec + 1e-6 * ru.ru_utime.tv_usec + ru.ru_stime.tv_sec + 1e-6 * ru.ru_stime.tv_usec;
-    std::printf("   chains of %d, %zu components at the end, RTM by CPU time %.1f", k, components, w.time() / cpu);
+    std::printf("   chains of %d, %zu components at the end, RTM by CPU time %.1f", k, components, timed_s / cpu);
   }
   if (o.profile) {
     const sbot::World::StepProfile& p = w.profile();
@@ -195,7 +208,7 @@ int main(int argc, char** argv) {
   const Options o = parse(argc, argv);
   if (o.scenario.empty()) {
     sbot_tools::requireLevel("sbot_bench", "--level", o.level);
-    std::printf("sbot_bench: headless core, flat arena, random walk, 1 core per run\n");
+    std::printf("sbot_bench: headless core, flat arena, %s, 1 core per run\n", o.idle ? "idle" : "random walk");
   } else {
     // Read here, before any row, so that a malformed file (or a count it cannot take) is refused once.
     try {
@@ -204,7 +217,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "sbot_bench: --scenario: %s\n", e.what());
       return 2;
     }
-    std::printf("sbot_bench: headless core, scenario %s, random walk, 1 core per run\n", o.scenario.c_str());
+    std::printf("sbot_bench: headless core, scenario %s, %s, 1 core per run\n", o.scenario.c_str(),
+                o.idle ? "idle" : "random walk");
   }
   std::printf("%-8s %7s %10s %12s %14s %12s\n", "level", "robots", "sim_s", "RTM", "wall_ms/step", "peak_MiB");
   std::fflush(stdout);

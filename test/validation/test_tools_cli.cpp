@@ -104,6 +104,28 @@ TEST(ToolsCli, BenchRunsAScenarioFile) {
   EXPECT_EQ(robots, 3) << fewer.output;  // the two listed and one of the swarm block
 }
 
+// --idle: the robots stand, fall asleep in the untimed settling, and only --seconds are timed; a
+// scenario that turns sleeping off keeps them in the solve.
+TEST(ToolsCli, BenchIdleRowsTimeStandingRobots) {
+  const Outcome asleep = sbot_test::runProcess(std::string(SBOT_BENCH_BIN) + " --idle --robots 3 --seconds 0.5");
+  ASSERT_EQ(asleep.status, 0) << asleep.output;
+  EXPECT_NE(asleep.output.find("flat arena, idle"), std::string::npos) << asleep.output;
+  std::istringstream r(asleep.output.substr(asleep.output.find("peak_MiB\n") + 9));
+  std::string level;
+  int robots = 0;
+  double sim_s = 0;
+  r >> level >> robots >> sim_s;
+  EXPECT_EQ(robots, 3) << asleep.output;
+  EXPECT_NEAR(sim_s, 0.5, 0.011) << "the settling is not timed: " << asleep.output;
+  EXPECT_NE(asleep.output.find("idle, 3 asleep at the end"), std::string::npos) << asleep.output;
+  const std::string file = testing::TempDir() + "bench_awake.yaml";
+  std::ofstream(file) << "world: {sleep_at_rest: false, terrain: {type: plane, arena: {size: 2.0, height: 0.1}}}\n"
+                         "swarm: {count: 2, level: simple, layout: grid, spacing: 0.3}\n";
+  const Outcome awake = sbot_test::runProcess(std::string(SBOT_BENCH_BIN) + " --idle --scenario " + file + " --seconds 0.2");
+  ASSERT_EQ(awake.status, 0) << awake.output;
+  EXPECT_NE(awake.output.find("idle, 0 asleep at the end"), std::string::npos) << awake.output;
+}
+
 // The last option without its value (two_sbots used to read it as "": --level "" then failed later
 // with an unrelated message).
 TEST(ToolsCli, AnOptionWithoutItsValueIsRefusedByName) {
