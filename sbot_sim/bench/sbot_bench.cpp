@@ -143,6 +143,13 @@ std::string levelsOf(sbot::World& w) {
   return level;
 }
 
+/// [s] user + system CPU time of this process so far.
+double cpuSeconds() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return ru.ru_utime.tv_sec + 1e-6 * ru.ru_utime.tv_usec + ru.ru_stime.tv_sec + 1e-6 * ru.ru_stime.tv_usec;
+}
+
 /// One row: `n` robots (--scenario: its swarm.count overridden, or its own robots for n < 0) on a
 /// random walk (or standing, --idle) for --seconds, in this process.
 void runOne(const Options& o, int n) {
@@ -160,6 +167,7 @@ void runOne(const Options& o, int n) {
   constexpr double kIdleSettle = 3.0;  // [s] standing robots are all asleep well within it (core_test_rest)
   if (o.idle) w.stepN(static_cast<int>(kIdleSettle / c.step));
   w.enableProfile(o.profile);
+  const double cpu0 = cpuSeconds();  // the settling (--idle) is not timed
   const auto t0 = std::chrono::steady_clock::now();
   for (int s = 0; s < steps; ++s) {
     if (!o.idle && s % change_every == 0) {
@@ -189,7 +197,7 @@ void runOne(const Options& o, int n) {
   }
   if (o.chains > 0) {
     // CPU-time RTM too: on a shared machine the wall clock includes waiting for a core.
-    const double cpu = ru.ru_utime.tv_sec + 1e-6 * ru.ru_utime.tv_usec + ru.ru_stime.tv_sec + 1e-6 * ru.ru_stime.tv_usec;
+    const double cpu = cpuSeconds() - cpu0;
     std::printf("   chains of %d, %zu components at the end, RTM by CPU time %.1f", k, components, timed_s / cpu);
   }
   if (o.profile) {

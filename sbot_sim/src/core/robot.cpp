@@ -652,9 +652,25 @@ void Robot::sleep() {
 }
 
 void Robot::wake() {
+  wakeByTouch();
+  last_command_wake_s_ = world_.time();
+}
+
+void Robot::wakeByTouch() {
   for (dBodyID b : bodies_) dBodyEnable(b);
   asleep_ = false;
   rest_watch_.reset();
+}
+
+void Robot::updateStanding() {
+  standing_ = false;
+  if (asleep_ || !commanded_still_ || world_.time() - last_command_wake_s_ < kServoSettle_s) return;
+  if (turret_hinge_ >= 0 && std::abs(turretAngle() - turret_target_) > 0.02) return;
+  for (dBodyID b : bodies_) {
+    const dReal* v = dBodyGetLinearVel(b);
+    if (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] > kStandingSpeed * kStandingSpeed) return;
+  }
+  standing_ = true;
 }
 
 void Robot::wakeIfDisturbed() {
@@ -669,9 +685,10 @@ void Robot::wakeIfDisturbed() {
 }
 
 void Robot::updateRest(const RestConfig& config) {
+  rest_ready_ = false;
   if (asleep_) {
     if (dBodyIsEnabled(baseBody())) {
-      wake();  // ODE's island walk enabled it (and all it is jointed to): touched or held by an awake body
+      wakeByTouch();  // ODE's island walk enabled it (and all it is jointed to): touched or held by an awake body
     } else {
       // The forces this robot's own command path added while it slept (rolling resistance, the
       // body drive) were not applied; clear them so that only new, external ones wake it.
@@ -686,13 +703,15 @@ void Robot::updateRest(const RestConfig& config) {
     rest_watch_.reset();
     return;
   }
-  const bool still = rest_watch_.stoodStill(bodies_, world_.time(), config);
+  rest_ready_ = rest_watch_.stoodStill(bodies_, world_.time(), config);
   rest_watch_.addLoad(drive_wheel_load_, drive_contact_force_);
-  if (still) {
-    drive_wheel_load_ = rest_watch_.meanLoad();
-    drive_contact_force_ = rest_watch_.meanForce();
-    sleep();
-  }
+}
+
+void Robot::sleepAtRest() {
+  drive_wheel_load_ = rest_watch_.meanLoad();
+  drive_contact_force_ = rest_watch_.meanForce();
+  rest_ready_ = false;
+  sleep();
 }
 
 // ---- stepping ------------------------------------------------------------------------------------

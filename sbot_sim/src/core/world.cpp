@@ -12,6 +12,9 @@
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
 
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/geom_info.h"
@@ -300,7 +303,8 @@ void World::wakeSleepersJointedToAwakeBodies() {
     woke = false;
     for (auto& r : robots_) {
       if (!r->asleep() || !jointedToAnEnabledBody(*r)) continue;
-      r->wake();
+      r->wakeByTouch();
+      joinHeldBackContactsOf(*r);
       woke = true;
     }
   }
@@ -316,6 +320,62 @@ bool World::jointedToAnEnabledBody(const Robot& robot) const {
     }
   }
   return false;
+}
+
+void World::releaseHeldBackContacts() {
+  if (held_back_.empty()) return;
+  // Pushed: robots that are not standing, and every awake robot in contact with a pushed one.
+  std::unordered_set<const Robot*> pushed;
+  for (const auto& r : robots_)
+    if (!r->asleep() && !r->standing()) pushed.insert(r.get());
+  for (bool grew = !pushed.empty(); grew;) {
+    grew = false;
+    for (const auto& [a, b] : awake_touches_)
+      if (pushed.count(a) != pushed.count(b)) grew = pushed.insert(pushed.count(a) ? b : a).second || grew;
+  }
+  for (const HeldBackContact& h : held_back_)
+    if (pushed.count(h.standing)) dJointAttach(h.joint, h.body_a, h.body_b);  // wakes its sleeper below
+}
+
+void World::joinHeldBackContactsOf(const Robot& sleeper) {
+  for (const HeldBackContact& h : held_back_)
+    if (h.sleeper == &sleeper) dJointAttach(h.joint, h.body_a, h.body_b);
+}
+
+// Robots joined by a connection or a static link fall asleep together: a sleeper jointed to an
+// awake robot is woken (above), so joined robots that became ready at different steps woke each
+// other for ever (20 standing chains of 5: 95 of 100 asleep at the end, RTM 60 against 158).
+void World::sleepRestingGroups() {
+  const int n = static_cast<int>(robots_.size());
+  std::vector<int> group(n);
+  bool any_ready = false;
+  for (int i = 0; i < n; ++i) {
+    group[i] = i;
+    any_ready = any_ready || robots_[i]->restReady();
+  }
+  if (!any_ready) return;
+  auto find = [&](int i) {
+    while (group[i] != i) i = group[i] = group[group[i]];
+    return i;
+  };
+  std::unordered_map<const Robot*, int> index;
+  for (int i = 0; i < n; ++i) index[robots_[i].get()] = i;
+  for (int i = 0; i < n; ++i) {
+    for (dBodyID body : robots_[i]->bodies()) {
+      for (int j = 0, nj = dBodyGetNumJoints(body); j < nj; ++j) {
+        const dJointID joint = dBodyGetJoint(body, j);
+        if (dJointGetType(joint) == dJointTypeContact) continue;  // the contact group is empty by now anyway
+        const dBodyID other = dJointGetBody(joint, 0) == body ? dJointGetBody(joint, 1) : dJointGetBody(joint, 0);
+        const Robot* joined = other ? static_cast<const Robot*>(dBodyGetData(other)) : nullptr;
+        if (joined && joined != robots_[i].get()) group[find(i)] = find(index.at(joined));
+      }
+    }
+  }
+  std::vector<char> moving(n, 0);  // a group with an awake robot that is not ready stays awake
+  for (int i = 0; i < n; ++i)
+    if (!robots_[i]->asleep() && !robots_[i]->restReady()) moving[find(i)] = 1;
+  for (int i = 0; i < n; ++i)
+    if (robots_[i]->restReady() && !moving[find(i)]) robots_[i]->sleepAtRest();
 }
 
 void World::wakeAll() {
@@ -349,7 +409,11 @@ void World::step() {
   for (auto& r : robots_) r->wakeIfDisturbed();
   for (auto& r : robots_) r->applyCommands(dt, effects_);
   lap(profile_.commands_s);
+  for (auto& r : robots_) r->updateStanding();
+  held_back_.clear();
+  awake_touches_.clear();
   dSpaceCollide(space_, this, &nearCallback);  // robot against robot
+  releaseHeldBackContacts();
   wakeSleepersJointedToAwakeBodies();
   // A sleeping robot's contacts with the terrain join no island (ODE solves only what an enabled
   // body reaches), so they are not made: in an idle swarm they were most of the step.
@@ -371,6 +435,7 @@ void World::step() {
   time_ += dt;
   ++steps_;
   for (auto& r : robots_) r->updateRest(config_.rest);
+  sleepRestingGroups();
   lap(profile_.feedback_s);
   ++profile_.steps;
 }
@@ -441,6 +506,15 @@ void World::handlePair(dGeomID a, dGeomID b) {
   ContactContext ctx;
   ctx.robot_a = ia ? ia->robot : nullptr;
   ctx.robot_b = ib ? ib->robot : nullptr;
+  // Robot against robot: a sleeper that a standing (settling) robot touches stays asleep; two
+  // settling neighbours used to wake each other for ever (README, "Sleeping at rest").
+  const Robot* held_back_sleeper = nullptr;
+  if (ba && bb && ctx.robot_a && ctx.robot_b && ctx.robot_a != ctx.robot_b) {
+    const bool awake_a = dBodyIsEnabled(ba), awake_b = dBodyIsEnabled(bb);
+    if (awake_a && awake_b) awake_touches_.emplace_back(ctx.robot_a, ctx.robot_b);
+    else if (awake_a && ctx.robot_a->standing()) held_back_sleeper = ctx.robot_b;
+    else if (awake_b && ctx.robot_b->standing()) held_back_sleeper = ctx.robot_a;
+  }
   ctx.material_a = ia ? ia->material : kGround;
   ctx.material_b = ib ? ib->material : kGround;
   const ContactConfig& cc = config_.contact;
@@ -482,7 +556,14 @@ void World::handlePair(dGeomID a, dGeomID b) {
     }
     dJointID c = dJointCreateContact(world_, contacts_, &contacts[i]);
     ++profile_.contacts;
-    dJointAttach(c, ba, bb);
+    if (held_back_sleeper) {
+      // The sleeper stands as a static body for its standing neighbour (releaseHeldBackContacts).
+      const bool a_sleeps = held_back_sleeper == ctx.robot_a;
+      dJointAttach(c, a_sleeps ? nullptr : ba, a_sleeps ? bb : nullptr);
+      held_back_.push_back({c, ba, bb, held_back_sleeper, a_sleeps ? ctx.robot_b : ctx.robot_a});
+    } else {
+      dJointAttach(c, ba, bb);
+    }
     const bool wheel_a = ia && ia->drive_wheel, wheel_b = ib && ib->drive_wheel;
     if (wheel_a || wheel_b) {
       wheel_contacts_.push_back({{}, ctx.normal, wheel_a ? ia->robot : nullptr, wheel_b ? ib->robot : nullptr, ba == nullptr,

@@ -8,7 +8,8 @@
 // the same artefact the same way (ODE's own auto-disable, Bullet's deactivation); ours watches
 // displacement over a window rather than instantaneous speed, because quickstep's jitter at rest
 // (a standing Simple rocks by up to 1.3 deg) is faster than any speed threshold that would not also
-// freeze real slow motion.
+// freeze real slow motion. Robots that touch or are joined settle at different times; World keeps
+// them from waking each other (README, "Sleeping at rest", *Neighbours and groups*).
 #pragma once
 
 #include <ode/ode.h>

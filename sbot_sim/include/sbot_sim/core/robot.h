@@ -190,11 +190,26 @@ class Robot {
   /// enabled (setBasePose, a rebuild) or carry a force or torque (an external push).
   void wakeIfDisturbed();
   /// After the step: a sleeping robot that ODE woke (a contact or joint with an awake body) is
-  /// awake again; an awake one commanded to stand that stood still for the window falls asleep.
+  /// awake again; an awake one commanded to stand that stood still for the window is restReady().
   void updateRest(const RestConfig& config);
+  /// Awake, commanded to stand, and still for the whole window. World puts it to sleep together
+  /// with the robots joined to it (connections, static links), once they are all ready.
+  bool restReady() const { return rest_ready_; }
+  /// Out of the solve now, keeping the window's mean drive-contact loads (World calls it).
+  void sleepAtRest();
+  /// Before collision: awake, tracks commanded to stand, no servo moving or commanded in the last
+  /// kServoSettle_s, and no body faster than kStandingSpeed. A sleeper it touches stays asleep
+  /// and stands as a static body for it (World::handlePair): settling neighbours no longer wake
+  /// each other.
+  bool standing() const { return standing_; }
+  void updateStanding();
+  static constexpr double kStandingSpeed = 0.08;  ///< [m/s] above quickstep's jitter at rest (<= 0.05)
+  static constexpr double kServoSettle_s = 2.0;   ///< [s] a servo command moves the robot this long
   /// Back into the solve, the rest window restarted. Every command that changes a target calls it
   /// (a track speed through applyCommands, the turret, the gripper, the side arm).
   void wake();
+  /// Woken by a contact or joint with an awake body (World): as wake(), but it commands nothing.
+  void wakeByTouch();
   const std::vector<dBodyID>& bodies() const { return bodies_; }
   std::size_t geomCount() const { return geoms_.size(); }
 
@@ -283,6 +298,9 @@ class Robot {
   double turret_target_ = 0;             ///< [rad]
   bool passive_ = false;
   bool asleep_ = false;                  ///< see asleep()
+  bool rest_ready_ = false;              ///< see restReady()
+  bool standing_ = false;                ///< see standing()
+  double last_command_wake_s_ = -1e9;    ///< [s] world time of the last wake() (commands, disturbances)
   bool commanded_still_ = false;         ///< both tracks commanded 0 in the last applyCommands
   RestWatch rest_watch_;
   void sleep();

@@ -161,6 +161,22 @@ class World {
   /// step, a connection, a static link) ties to an awake body, as ODE's island walk would mid-step.
   void wakeSleepersJointedToAwakeBodies();
   bool jointedToAnEnabledBody(const Robot& robot) const;
+  /// A contact between a sleeper and a standing robot, made against the sleeper as a static body.
+  struct HeldBackContact {
+    dJointID joint;
+    dBodyID body_a, body_b;  ///< the contact's two bodies, as dCollide gave them
+    const Robot* sleeper;
+    const Robot* standing;
+  };
+  std::vector<HeldBackContact> held_back_;   ///< this step's (handlePair)
+  std::vector<std::pair<const Robot*, const Robot*>> awake_touches_;  ///< this step's awake robot pairs in contact
+  /// After robot-robot collision: a held-back contact whose standing robot is pushed (in contact,
+  /// directly or through other awake robots, with one that is not standing) joins its sleeper.
+  void releaseHeldBackContacts();
+  void joinHeldBackContactsOf(const Robot& sleeper);
+  /// After the step: robots joined by connections or static links fall asleep together, once
+  /// every awake one of them is restReady(); a robot joined to none sleeps on its own.
+  void sleepRestingGroups();
   Robot* robotOwning(dGeomID g) const;
   const std::string& materialOf(dGeomID g) const;
 
