@@ -665,7 +665,8 @@ void Robot::wakeByTouch() {
 void Robot::updateStanding() {
   standing_ = false;
   if (asleep_ || !commanded_still_ || world_.time() - last_command_wake_s_ < kServoSettle_s) return;
-  if (turret_hinge_ >= 0 && std::abs(turretAngle() - turret_target_) > 0.02) return;
+  constexpr double kTurretAtTarget = 0.02;  // [rad] the servo has settled
+  if (turret_hinge_ >= 0 && std::abs(turretAngle() - turret_target_) > kTurretAtTarget) return;
   for (dBodyID b : bodies_) {
     const dReal* v = dBodyGetLinearVel(b);
     if (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] > kStandingSpeed * kStandingSpeed) return;

@@ -310,12 +310,21 @@ void World::wakeSleepersJointedToAwakeBodies() {
   }
 }
 
+namespace {
+
+/// The body that `joint` ties `body` to (null for the static world).
+dBodyID otherBody(dJointID joint, dBodyID body) {
+  return dJointGetBody(joint, 0) == body ? dJointGetBody(joint, 1) : dJointGetBody(joint, 0);
+}
+
+}  // namespace
+
 bool World::jointedToAnEnabledBody(const Robot& robot) const {
   for (dBodyID b : robot.bodies()) {
     for (int i = 0, n = dBodyGetNumJoints(b); i < n; ++i) {
       const dJointID j = dBodyGetJoint(b, i);
       if (!dJointIsEnabled(j)) continue;  // ODE walks enabled joints only
-      const dBodyID other = dJointGetBody(j, 0) == b ? dJointGetBody(j, 1) : dJointGetBody(j, 0);
+      const dBodyID other = otherBody(j, b);
       if (other && dBodyIsEnabled(other)) return true;  // a sleeper's own bodies are all disabled
     }
   }
@@ -360,12 +369,11 @@ void World::sleepRestingGroups() {
   };
   std::unordered_map<const Robot*, int> index;
   for (int i = 0; i < n; ++i) index[robots_[i].get()] = i;
+  // The step's contacts are gone by now: the joints left between robots are connections and links.
   for (int i = 0; i < n; ++i) {
     for (dBodyID body : robots_[i]->bodies()) {
       for (int j = 0, nj = dBodyGetNumJoints(body); j < nj; ++j) {
-        const dJointID joint = dBodyGetJoint(body, j);
-        if (dJointGetType(joint) == dJointTypeContact) continue;  // the contact group is empty by now anyway
-        const dBodyID other = dJointGetBody(joint, 0) == body ? dJointGetBody(joint, 1) : dJointGetBody(joint, 0);
+        const dBodyID other = otherBody(dBodyGetJoint(body, j), body);
         const Robot* joined = other ? static_cast<const Robot*>(dBodyGetData(other)) : nullptr;
         if (joined && joined != robots_[i].get()) group[find(i)] = find(index.at(joined));
       }
