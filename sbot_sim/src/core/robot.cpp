@@ -109,6 +109,7 @@ void Robot::build(const Pose& base_pose) {
   // 2. One ODE body per group, its frame at the group's centre of mass (ODE requires that).
   const double inertia_floor = std::atof(d.extraOr("inertia_floor_kgm2", "0").c_str());
   space_ = dSimpleSpaceCreate(world_.space());
+  dGeomSetData(reinterpret_cast<dGeomID>(space_), this);  // World::handlePair reads it
   std::vector<Pose> body_T_group(groups.size());
   for (std::size_t gi = 0; gi < groups.size(); ++gi) {
     dMass total;

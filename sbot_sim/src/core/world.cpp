@@ -296,15 +296,24 @@ std::vector<Robot*> World::robots() {
 // made, a gripper or side-arm connection, a static link) ties to an enabled one. A robot woken that
 // way would be solved without the terrain contacts its sleep skipped, and drop for a step; so wake
 // those robots here, before the terrain is collided, until no sleeper is jointed to an awake body
-// (a chain of held robots wakes link by link).
+// (a chain of held robots wakes link by link). The robot-robot pass skipped pairs of sleepers
+// (handlePair): a robot woken here is collided with the robots that slept then, and a sleeper it
+// touches wakes in turn, as the skipped contact would have woken it.
 void World::wakeSleepersJointedToAwakeBodies() {
+  const std::size_t n = robots_.size();
+  std::vector<char> slept_in_pass(n), collided_again(n, 0);
+  for (std::size_t i = 0; i < n; ++i) slept_in_pass[i] = robots_[i]->asleep();
   bool woke = true;
   while (woke) {
     woke = false;
-    for (auto& r : robots_) {
-      if (!r->asleep() || !jointedToAnEnabledBody(*r)) continue;
-      r->wakeByTouch();
-      joinHeldBackContactsOf(*r);
+    for (std::size_t i = 0; i < n; ++i) {
+      Robot& r = *robots_[i];
+      if (!r.asleep() || !jointedToAnEnabledBody(r)) continue;
+      r.wakeByTouch();
+      joinHeldBackContactsOf(r);
+      for (std::size_t k = 0; k < n; ++k)  // a pair is collided once: skip robots already done
+        if (k != i && slept_in_pass[k] && !collided_again[k]) collideRobots(r, *robots_[k]);
+      collided_again[i] = 1;
       woke = true;
     }
   }
@@ -494,8 +503,28 @@ void World::collideWithTerrain(Robot& r) {
   }
 }
 
+// What the robot-robot pass (dSpaceCollide of the robots' spaces) does for one pair.
+void World::collideRobots(const Robot& a, const Robot& b) {
+  dReal box_a[6], box_b[6];
+  dGeomGetAABB(reinterpret_cast<dGeomID>(a.space()), box_a);
+  dGeomGetAABB(reinterpret_cast<dGeomID>(b.space()), box_b);
+  if (boxesMeet(box_a, box_b)) dSpaceCollide2(reinterpret_cast<dGeomID>(a.space()), reinterpret_cast<dGeomID>(b.space()), this, &nearCallback);
+}
+
+namespace {
+
+/// The robot whose geoms `g` holds if `g` is a robot's space (Robot sets itself as its data).
+const Robot* robotOfSpace(dGeomID g) { return dGeomIsSpace(g) ? static_cast<const Robot*>(dGeomGetData(g)) : nullptr; }
+
+}  // namespace
+
 void World::handlePair(dGeomID a, dGeomID b) {
   if (dGeomIsSpace(a) || dGeomIsSpace(b)) {
+    // Two sleeping robots' contacts would join no island (ODE solves only what an enabled body
+    // reaches): not made; in a resting cluster they were half the step. If one of them wakes,
+    // wakeSleepersJointedToAwakeBodies makes them.
+    const Robot *robot_a = robotOfSpace(a), *robot_b = robotOfSpace(b);
+    if (robot_a && robot_b && robot_a->asleep() && robot_b->asleep()) return;
     // A robot's own space is never collided with itself: self-collision is off, like the seed.
     dSpaceCollide2(a, b, this, &nearCallback);
     return;

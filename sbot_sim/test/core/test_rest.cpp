@@ -162,22 +162,62 @@ int wakeUps(World& w, const std::vector<Robot*>& robots, double seconds) {
   return wakes;
 }
 
+// 25 standing Simples on a 5 x 5 grid 11.8 cm apart: the 11.4 cm turrets touch as the robots settle.
+std::vector<Robot*> touchingCluster(World& w) {
+  std::vector<Robot*> cluster;
+  for (int i = 0; i < 25; ++i)
+    cluster.push_back(&w.addRobot(loadLevel("simple"), {0.118 * (i % 5), 0.118 * (i / 5), 0.7 * i}, "sbot_" + std::to_string(i)));
+  return cluster;
+}
+
 // Neighbours that touch and settle at different times fall asleep and stay asleep: a sleeper stands
 // as a static body for a neighbour that is itself standing. Before, a settling neighbour woke it:
 // in this cluster each robot was asleep 32 % of the steps, with 1366 wake-ups in 10 s.
 TEST(Rest, TouchingNeighboursThatSettleAtDifferentTimesStayAsleep) {
   World w(flatWorld());
-  std::vector<Robot*> cluster;
-  for (int i = 0; i < 25; ++i)  // 11.8 cm apart: the 11.4 cm turrets touch as the robots settle
-    cluster.push_back(&w.addRobot(loadLevel("simple"), {0.118 * (i % 5), 0.118 * (i / 5), 0.7 * i}, "sbot_" + std::to_string(i)));
+  const std::vector<Robot*> cluster = touchingCluster(w);
   runFor(w, 8.0);
   for (const Robot* r : cluster) EXPECT_TRUE(r->asleep()) << r->name();
   EXPECT_EQ(wakeUps(w, cluster, 3.0), 0);
 }
 
+// Whether the geoms of two robots touch, as the robot-robot pass would find it.
+bool touching(const Robot& a, const Robot& b) {
+  int contacts = 0;
+  dSpaceCollide2(reinterpret_cast<dGeomID>(a.space()), reinterpret_cast<dGeomID>(b.space()), &contacts,
+                 [](void* count, dGeomID g1, dGeomID g2) {
+                   dContactGeom c;
+                   *static_cast<int*>(count) += dCollide(g1, g2, 1, &c, sizeof c);
+                 });
+  return contacts > 0;
+}
+
+// Two sleepers' contacts would join no island, so the robot-robot pass does not make them (in a
+// resting cluster of 100 they were 53 contact joints a step, half the step's time). A sleeper that
+// a touch wakes is collided with its sleeping neighbours before the solve, so the robots it rests
+// against wake in the same step, as ODE's island walk woke them while those contacts were made.
+TEST(Rest, ASleepingClusterMakesNoContactsAndATouchWakesWhatItTouchesInTheSameStep) {
+  World w(flatWorld());
+  const std::vector<Robot*> cluster = touchingCluster(w);
+  runFor(w, 8.0);
+  w.enableProfile(true);
+  runFor(w, 1.0);
+  EXPECT_EQ(w.profile().contacts, 0u) << "contact joints made in 1 s of a cluster asleep";
+  std::vector<std::pair<Robot*, Robot*>> touches;
+  for (std::size_t i = 0; i < cluster.size(); ++i)
+    for (std::size_t j = i + 1; j < cluster.size(); ++j)
+      if (touching(*cluster[i], *cluster[j])) touches.emplace_back(cluster[i], cluster[j]);
+  Robot* nudged = cluster[12];  // in the middle; it rests against neighbours that rest on others
+  ASSERT_GE(std::count_if(touches.begin(), touches.end(), [&](const auto& t) { return t.first == nudged || t.second == nudged; }), 1);
+  dBodyAddForce(nudged->baseBody(), 0, 0, 0.01);  // wakes it
+  w.step();
+  for (const auto& [a, b] : touches)
+    EXPECT_EQ(a->asleep(), b->asleep()) << a->name() << " and " << b->name() << " touch";
+}
+
 // A robot that drives into a neighbour that stands beside a sleeper pushes the sleeper as far as
-// with sleep off. (The neighbour, just set down, is not standing yet here: this checks the push, not
-// the release of a held-back contact, which no test isolates.)
+// with sleep off. (The neighbour, just set down, is not standing yet here: this checks the push, the
+// next test the release of a held-back contact.)
 TEST(Rest, ARobotPushedIntoASleeperPushesIt) {
   const auto sleeperShift = [](bool sleep) {
     WorldConfig c = flatWorld();
@@ -196,6 +236,37 @@ TEST(Rest, ARobotPushedIntoASleeperPushesIt) {
   const double asleep = sleeperShift(true), solved = sleeperShift(false);
   ASSERT_GT(solved, 0.003);
   EXPECT_GT(asleep, 0.5 * solved) << "pushed " << asleep << " m against " << solved << " m with sleep off";
+}
+
+// The release of a held-back contact. A neighbour asleep 1.7 cm from a sleeper, woken by a pusher
+// driving slower than Robot::kStandingSpeed, stands (3 s since its last command, its bodies slow)
+// when it reaches the sleeper, so their contact holds the sleeper static; only because the pusher
+// drives (World::releaseHeldBackContacts) does that contact join the sleeper and push it. (The
+// two are Fast robots, 33 g: a Simple does not shove two of its own kind.)
+TEST(Rest, ASleeperIsPushedThroughAStandingNeighbourThatADrivingRobotShoves) {
+  const auto sleeperShift = [](bool sleep) {
+    WorldConfig c = flatWorld();
+    c.rest.enabled = sleep;
+    World w(c);
+    Robot& sleeper = w.addRobot(loadLevel("fast"), {0.19, 0, 0}, "sleeper");
+    Robot& neighbour = w.addRobot(loadLevel("fast"), {0.116, 0, 0}, "neighbour");
+    runFor(w, 3.0);
+    EXPECT_EQ(sleeper.asleep(), sleep);
+    EXPECT_EQ(neighbour.asleep(), sleep);
+    const double x0 = sleeper.basePose().position.x();
+    w.addRobot(loadLevel("simple"), {0.02, 0, 0}, "pusher").setSpeed(10, 10);  // 2.8 cm/s
+    bool stood_while_pushed = false;
+    for (int i = 0; i < 300; ++i) {
+      w.step();
+      stood_while_pushed = stood_while_pushed || neighbour.standing();
+    }
+    if (sleep) EXPECT_TRUE(stood_while_pushed) << "the neighbour must stand while it is shoved";
+    return sleeper.basePose().position.x() - x0;
+  };
+  const double asleep = sleeperShift(true), solved = sleeperShift(false);
+  ASSERT_GT(solved, 0.03);
+  // Held back until the neighbour's speed flickers past kStandingSpeed it moved 0.047 m (0.67).
+  EXPECT_GT(asleep, 0.9 * solved) << "pushed " << asleep << " m against " << solved << " m with sleep off";
 }
 
 // Robots joined by static links fall asleep as one group and stay asleep: a sleeper jointed to an

@@ -161,6 +161,7 @@ class World {
   /// step, a connection, a static link) ties to an awake body, as ODE's island walk would mid-step.
   void wakeSleepersJointedToAwakeBodies();
   bool jointedToAnEnabledBody(const Robot& robot) const;
+  void collideRobots(const Robot& a, const Robot& b);
   /// A contact between a sleeper and a standing robot, made against the sleeper as a static body.
   struct HeldBackContact {
     dJointID joint;
