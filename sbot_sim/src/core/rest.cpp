@@ -44,6 +44,7 @@ bool RestWatch::stoodStill(const std::vector<dBodyID>& bodies, double now_s, con
     const bool heavy = masses_[i] >= config.heavy_fraction * total_mass_;
     if ((positionOf(bodies[i]) - positions_[i]).norm() > config.max_shift_m ||
         (heavy && orientationOf(bodies[i]).angularDistance(orientations_[i]) > config.max_turn_rad)) {
+      last_move_s_ = now_s;
       start(bodies, now_s);
       return false;
     }

@@ -666,6 +666,7 @@ void Robot::wakeByTouch() {
 void Robot::updateStanding() {
   standing_ = false;
   if (asleep_ || !commanded_still_ || world_.time() - last_command_wake_s_ < kServoSettle_s) return;
+  if (world_.time() - rest_watch_.lastMoveAt() < kMovedRecently_s) return;  // pushed or dragged, not jittering
   constexpr double kTurretAtTarget = 0.02;  // [rad] the servo has settled
   if (turret_hinge_ >= 0 && std::abs(turretAngle() - turret_target_) > kTurretAtTarget) return;
   for (dBodyID b : bodies_) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 #include "sbot_sim/core/actuators/connections.h"
 #include "sbot_sim/core/swarm/swarm_graph.h"
@@ -207,8 +208,16 @@ TEST(Rest, ASleepingClusterMakesNoContactsAndATouchWakesWhatItTouchesInTheSameSt
   for (std::size_t i = 0; i < cluster.size(); ++i)
     for (std::size_t j = i + 1; j < cluster.size(); ++j)
       if (touching(*cluster[i], *cluster[j])) touches.emplace_back(cluster[i], cluster[j]);
-  Robot* nudged = cluster[12];  // in the middle; it rests against neighbours that rest on others
-  ASSERT_GE(std::count_if(touches.begin(), touches.end(), [&](const auto& t) { return t.first == nudged || t.second == nudged; }), 1);
+  // Nudge a robot whose neighbour rests against a third: the third wakes only by the second pass.
+  std::map<Robot*, int> degree;
+  for (const auto& [a, b] : touches) ++degree[a], ++degree[b];
+  Robot* nudged = nullptr;
+  for (const auto& [a, b] : touches) {
+    if (degree[b] >= 2) nudged = a;
+    else if (degree[a] >= 2) nudged = b;
+    if (nudged) break;
+  }
+  ASSERT_NE(nudged, nullptr) << "no three robots of the cluster rest against each other";
   dBodyAddForce(nudged->baseBody(), 0, 0, 0.01);  // wakes it
   w.step();
   for (const auto& [a, b] : touches)
@@ -267,6 +276,43 @@ TEST(Rest, ASleeperIsPushedThroughAStandingNeighbourThatADrivingRobotShoves) {
   ASSERT_GT(solved, 0.03);
   // Held back until the neighbour's speed flickers past kStandingSpeed it moved 0.047 m (0.67).
   EXPECT_GT(asleep, 0.9 * solved) << "pushed " << asleep << " m against " << solved << " m with sleep off";
+}
+
+// A standing robot moved by something that is not a robot in contact (here a pull on a spring, as
+// a user's drag or a gripper's would) wakes a sleeper it is moved into: having moved past the rest
+// limits in the last Robot::kMovedRecently_s, it does not stand. Standing, it leaned on the sleeper
+// as on a wall and the pull stalled until the spring had stretched 8 mm. The drag starts 2.5 s
+// before the robots meet, past the 2 s in which the pull's own wake keeps the robot from standing.
+TEST(Rest, ARobotDraggedIntoASleeperPushesItWithoutStalling) {
+  struct Drag {
+    double sleeper_shift;  ///< [m]
+    double max_lag;        ///< [m] of the dragged robot behind the spring's end
+  };
+  const auto drag = [](bool sleep) {
+    WorldConfig c = flatWorld();
+    c.rest.enabled = sleep;
+    World w(c);
+    Robot& sleeper = w.addRobot(loadLevel("fast"), {0.223, 0, 0}, "sleeper");
+    Robot& dragged = w.addRobot(loadLevel("fast"), {0.116, 0, 0}, "dragged");
+    runFor(w, 3.0);
+    EXPECT_EQ(sleeper.asleep(), sleep);
+    const double x0 = sleeper.basePose().position.x(), start = dragged.basePose().position.x();
+    constexpr double kSpeed = 0.02, kStiffness = 50, kDamping = 2;  // [m/s], [N/m], [N s/m]
+    Drag d{0, 0};
+    for (int i = 1; i <= 500; ++i) {
+      const double target = start + kSpeed * i * w.config().step;
+      const double x = dragged.basePose().position.x(), v = dBodyGetLinearVel(dragged.baseBody())[0];
+      dBodyAddForce(dragged.baseBody(), kStiffness * (target - x) - kDamping * (v - kSpeed), 0, 0);
+      w.step();
+      d.max_lag = std::max(d.max_lag, target - x);
+    }
+    d.sleeper_shift = sleeper.basePose().position.x() - x0;
+    return d;
+  };
+  const Drag asleep = drag(true), solved = drag(false);
+  ASSERT_GT(solved.sleeper_shift, 0.02);
+  EXPECT_GT(asleep.sleeper_shift, 0.9 * solved.sleeper_shift);
+  EXPECT_LT(asleep.max_lag, 2 * solved.max_lag) << "lagged " << asleep.max_lag << " m against " << solved.max_lag << " m with sleep off";
 }
 
 // Robots joined by static links fall asleep as one group and stay asleep: a sleeper jointed to an

@@ -14,6 +14,7 @@
 
 #include <ode/ode.h>
 
+#include <limits>
 #include <vector>
 
 #include "sbot_sim/core/types.h"
@@ -32,6 +33,9 @@ class RestWatch {
   /// none) and start a new one if any moved beyond the limits. True when they stayed within them
   /// for the whole window.
   bool stoodStill(const std::vector<dBodyID>& bodies, double now_s, const RestConfig& config);
+  /// [s] when the bodies last moved beyond the limits (a window restarted by motion; -inf if never).
+  /// reset() keeps it: a robot woken by a touch has not moved for that.
+  double lastMoveAt() const { return last_move_s_; }
   /// One step's drive-contact load [N] and force [N], added to the current window's means.
   void addLoad(double load, const Vec3& force) {
     ++samples_;
@@ -45,6 +49,7 @@ class RestWatch {
   void start(const std::vector<dBodyID>& bodies, double now_s);
   bool started_ = false;
   double since_s_ = 0;
+  double last_move_s_ = -std::numeric_limits<double>::infinity();
   std::vector<Vec3> positions_;
   std::vector<Quat> orientations_;
   std::vector<double> masses_;  ///< [kg] per body

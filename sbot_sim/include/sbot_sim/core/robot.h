@@ -198,13 +198,16 @@ class Robot {
   /// Out of the solve now, keeping the window's mean drive-contact loads (World calls it).
   void sleepAtRest();
   /// Before collision: awake, tracks commanded to stand, no servo moving or commanded in the last
-  /// kServoSettle_s, and no body faster than kStandingSpeed. A sleeper it touches stays asleep
-  /// and stands as a static body for it (World::handlePair): settling neighbours no longer wake
-  /// each other.
+  /// kServoSettle_s, no body faster than kStandingSpeed, and none moved beyond the rest limits
+  /// (RestConfig) in the last kMovedRecently_s. A sleeper it touches stays asleep and stands as a
+  /// static body for it (World::handlePair): settling neighbours no longer wake each other.
   bool standing() const { return standing_; }
   void updateStanding();
   static constexpr double kStandingSpeed = 0.08;  ///< [m/s] above quickstep's jitter at rest (<= 0.05)
   static constexpr double kServoSettle_s = 2.0;   ///< [s] a servo command moves the robot this long
+  /// [s] a robot that moved past the rest limits (3 mm) this recently is being pushed or dragged
+  /// (at >= ~1.2 cm/s), not rocking: quickstep's creep at rest takes ~1.5 s for 3 mm.
+  static constexpr double kMovedRecently_s = 0.25;
   /// Back into the solve, the rest window restarted. Every command that changes a target calls it
   /// (a track speed through applyCommands, the turret, the gripper, the side arm).
   void wake();
