@@ -13,6 +13,12 @@
 namespace sbot::test {
 namespace {
 
+WorldConfig flatWorldWithSleep(bool sleep, std::uint64_t seed = 1) {
+  WorldConfig c = flatWorld(seed);
+  c.rest.enabled = sleep;
+  return c;
+}
+
 double planarDistance(const Pose& a, const Pose& b) { return (a.position - b.position).head<2>().norm(); }
 
 class RestEveryLevel : public ::testing::TestWithParam<const char*> {};
@@ -60,9 +66,7 @@ TEST(Rest, ASwarmOfStandingSimplesFallsAsleepQuickly) {
 // Wakes on a track command and then drives exactly as a robot that never slept: the same speed.
 TEST(Rest, ASpeedCommandWakesItAndItDrivesAsBefore) {
   auto speedAfterStart = [](bool sleep) {
-    WorldConfig c = flatWorld(5);
-    c.rest.enabled = sleep;
-    World w(c);
+    World w(flatWorldWithSleep(sleep, 5));
     Robot& r = w.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_0");
     runFor(w, 3.0);
     EXPECT_EQ(r.asleep(), sleep);
@@ -229,9 +233,7 @@ TEST(Rest, ASleepingClusterMakesNoContactsAndATouchWakesWhatItTouchesInTheSameSt
 // stands when the push starts.)
 TEST(Rest, ARobotPushedIntoASleeperPushesIt) {
   const auto sleeperShift = [](bool sleep) {
-    WorldConfig c = flatWorld();
-    c.rest.enabled = sleep;
-    World w(c);
+    World w(flatWorldWithSleep(sleep));
     Robot& sleeper = w.addRobot(loadLevel("simple"), {0.232, 0, 0}, "sleeper");
     runFor(w, 3.0);
     EXPECT_EQ(sleeper.asleep(), sleep);
@@ -247,6 +249,21 @@ TEST(Rest, ARobotPushedIntoASleeperPushesIt) {
   EXPECT_GT(asleep, 0.5 * solved) << "pushed " << asleep << " m against " << solved << " m with sleep off";
 }
 
+// Two Fast robots (33 g) that stood for 3 s on the floor, sleep at rest on or off: `sleeper` at
+// x = sleeper_x, `neighbour` at x = 0.116 m.
+struct StandingFastPair {
+  StandingFastPair(bool sleep, double sleeper_x)
+      : w(flatWorldWithSleep(sleep)),
+        sleeper(w.addRobot(loadLevel("fast"), {sleeper_x, 0, 0}, "sleeper")),
+        neighbour(w.addRobot(loadLevel("fast"), {0.116, 0, 0}, "neighbour")) {
+    runFor(w, 3.0);
+    EXPECT_EQ(sleeper.asleep(), sleep);
+  }
+  World w;
+  Robot& sleeper;
+  Robot& neighbour;
+};
+
 // A neighbour asleep 1.7 cm from a sleeper, woken by a pusher driving slower than
 // Robot::kStandingSpeed, is shoved into the sleeper, which must move as far as with sleep off. The
 // neighbour stands when the push starts (3 s since its last command, its bodies slow). Without
@@ -256,23 +273,17 @@ TEST(Rest, ARobotPushedIntoASleeperPushesIt) {
 // and groups"). (The two are Fast robots, 33 g: a Simple does not shove two of its own kind.)
 TEST(Rest, ASleeperIsPushedThroughAStandingNeighbourThatADrivingRobotShoves) {
   const auto sleeperShift = [](bool sleep) {
-    WorldConfig c = flatWorld();
-    c.rest.enabled = sleep;
-    World w(c);
-    Robot& sleeper = w.addRobot(loadLevel("fast"), {0.19, 0, 0}, "sleeper");
-    Robot& neighbour = w.addRobot(loadLevel("fast"), {0.116, 0, 0}, "neighbour");
-    runFor(w, 3.0);
-    EXPECT_EQ(sleeper.asleep(), sleep);
-    EXPECT_EQ(neighbour.asleep(), sleep);
-    const double x0 = sleeper.basePose().position.x();
-    w.addRobot(loadLevel("simple"), {0.02, 0, 0}, "pusher").setSpeed(10, 10);  // 2.8 cm/s
+    StandingFastPair pair(sleep, 0.19);
+    EXPECT_EQ(pair.neighbour.asleep(), sleep);
+    const double x0 = pair.sleeper.basePose().position.x();
+    pair.w.addRobot(loadLevel("simple"), {0.02, 0, 0}, "pusher").setSpeed(10, 10);  // 2.8 cm/s
     bool stood_while_pushed = false;
     for (int i = 0; i < 300; ++i) {
-      w.step();
-      stood_while_pushed = stood_while_pushed || neighbour.standing();
+      pair.w.step();
+      stood_while_pushed = stood_while_pushed || pair.neighbour.standing();
     }
     if (sleep) EXPECT_TRUE(stood_while_pushed) << "the neighbour must stand at some step of the push";
-    return sleeper.basePose().position.x() - x0;
+    return pair.sleeper.basePose().position.x() - x0;
   };
   const double asleep = sleeperShift(true), solved = sleeperShift(false);
   ASSERT_GT(solved, 0.03);
@@ -290,13 +301,10 @@ TEST(Rest, ARobotDraggedIntoASleeperPushesItWithoutStalling) {
     double max_lag;        ///< [m] of the dragged robot behind the spring's end
   };
   const auto drag = [](bool sleep) {
-    WorldConfig c = flatWorld();
-    c.rest.enabled = sleep;
-    World w(c);
-    Robot& sleeper = w.addRobot(loadLevel("fast"), {0.223, 0, 0}, "sleeper");
-    Robot& dragged = w.addRobot(loadLevel("fast"), {0.116, 0, 0}, "dragged");
-    runFor(w, 3.0);
-    EXPECT_EQ(sleeper.asleep(), sleep);
+    StandingFastPair pair(sleep, 0.223);
+    World& w = pair.w;
+    const Robot& sleeper = pair.sleeper;
+    Robot& dragged = pair.neighbour;
     const double x0 = sleeper.basePose().position.x(), start = dragged.basePose().position.x();
     constexpr double kSpeed = 0.02, kStiffness = 50, kDamping = 2;  // [m/s], [N/m], [N s/m]
     Drag d{0, 0};
