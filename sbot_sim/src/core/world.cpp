@@ -302,7 +302,12 @@ std::vector<Robot*> World::robots() {
 void World::wakeSleepersJointedToAwakeBodies() {
   const std::size_t n = robots_.size();
   std::vector<char> slept_in_pass(n), collided_again(n, 0);
-  for (std::size_t i = 0; i < n; ++i) slept_in_pass[i] = robots_[i]->asleep();
+  bool any_asleep = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    slept_in_pass[i] = robots_[i]->asleep();
+    any_asleep = any_asleep || slept_in_pass[i];
+  }
+  if (!any_asleep) return;  // a swarm that drives
   bool woke = true;
   while (woke) {
     woke = false;

@@ -282,7 +282,9 @@ TEST(Rest, ASleeperIsPushedThroughAStandingNeighbourThatADrivingRobotShoves) {
       pair.w.step();
       stood_while_pushed = stood_while_pushed || pair.neighbour.standing();
     }
-    if (sleep) EXPECT_TRUE(stood_while_pushed) << "the neighbour must stand at some step of the push";
+    if (sleep) {
+      EXPECT_TRUE(stood_while_pushed) << "the neighbour must stand at some step of the push";
+    }
     return pair.sleeper.basePose().position.x() - x0;
   };
   const double asleep = sleeperShift(true), solved = sleeperShift(false);

@@ -178,8 +178,6 @@ class World {
   /// After the step: robots joined by connections or static links fall asleep together, once
   /// every awake one of them is restReady(); a robot joined to none sleeps on its own.
   void sleepRestingGroups();
-  Robot* robotOwning(dGeomID g) const;
-  const std::string& materialOf(dGeomID g) const;
 
   WorldConfig config_;
   dWorldID world_ = nullptr;
