@@ -84,12 +84,13 @@ class Fields {
     known_.insert(k);
     return node_[k].IsDefined() && !node_[k].IsNull();
   }
-  std::string text(const std::string& k, bool required, const std::string& fallback = "") {
+  std::string text(const std::string& k, bool required, const std::string& fallback = "", const char* what = "a text") {
     if (!has(k)) {
       if (required) fail_(where_ + ": missing field '" + k + "'");
       return fallback;
     }
-    if (!node_[k].IsScalar()) fail_(where_ + ": field '" + k + "' must be a text");
+    if (!node_[k].IsScalar()) fail_(where_ + ": field '" + k + "' must be " + what + ", found a " +
+                                    (node_[k].IsSequence() ? "list" : "map"));
     const std::string t = node_[k].as<std::string>();
     if (required && t.empty()) fail_(where_ + ": field '" + k + "' is empty");
     return t;
@@ -98,7 +99,7 @@ class Fields {
   /// 0 m gap).
   double number(const std::string& k, bool required, double fallback = 0) {
     if (!has(k)) return required ? (text(k, true), 0.0) : fallback;
-    const std::string t = text(k, false);
+    const std::string t = text(k, false, "", "a number");
     char* end = nullptr;
     const double v = std::strtod(t.c_str(), &end);
     if (end == t.c_str() || *end != '\0' || !std::isfinite(v))
@@ -150,6 +151,34 @@ class Fields {
   const std::function<void(const std::string&)>& fail_;
   std::set<std::string> known_;
 };
+
+/// Why a table whose parameters are shown as `f` (value x scale, then f.unit) misnames the
+/// quantity of `kind` (its parameter in m, deg or rad: the text after the last ", " of its unit);
+/// empty when it does not. A unit this list does not know is the file's own and is not checked.
+std::string unitMismatch(const ExperimentKind& kind, const NumberFormat& f) {
+  struct Known { const char* unit; const char* of; double scale; };  // f.unit = value x scale, value in `of`
+  static const Known known[] = {{"m", "m", 1},        {"cm", "m", 100},      {"mm", "m", 1000},
+                                {"rad", "rad", 1},    {"mrad", "rad", 1000}, {"deg", "deg", 1},
+                                {"deg", "rad", 180 / M_PI}, {"°", "deg", 1},  {"°", "rad", 180 / M_PI}};
+  const std::size_t comma = kind.unit.rfind(", ");
+  const std::string of = comma == std::string::npos ? kind.unit : kind.unit.substr(comma + 2);
+  const std::string quantity = comma == std::string::npos ? "parameter" : kind.unit.substr(0, comma);
+  bool named = false;
+  for (const Known& k : known) {
+    if (f.unit != k.unit) continue;
+    named = true;
+    if (of == k.of && std::fabs(f.scale - k.scale) <= 1e-4 * k.scale) return "";
+  }
+  if (!named) return "";
+  std::ostringstream m;
+  m << kind.name << "'s parameter is a " << quantity << " in " << of << ", which the table's param format shows as x"
+    << f.scale << " " << f.unit << ": give the cells of another quantity a table of their own, or a param format of their unit (";
+  bool first = true;
+  for (const Known& k : known)
+    if (of == k.of) m << (first ? "" : ", ") << "unit " << k.unit << " scale " << k.scale, first = false;
+  m << ")";
+  return m.str();
+}
 
 /// {header, unit, scale, decimals}; without `default_header` the header is required.
 NumberFormat readFormat(const YAML::Node& node, const std::string& where, const std::string& default_header,
@@ -255,6 +284,8 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
         fail(m.str());
       }
     }
+    const std::string misnamed = unitMismatch(*kind, t.param);
+    if (!misnamed.empty()) fail(cat + ": " + misnamed);
     if (!contains(vocabulary.levels, c.level)) fail(cat + ": level '" + c.level + "' is not one of " + nameList(vocabulary.levels));
     for (std::size_t r = 0; r < t.references.size(); ++r) {
       const std::string& column = t.references[r];

@@ -39,6 +39,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <functional>
 #include <iomanip>
 #include <map>
@@ -297,6 +298,16 @@ std::string findHeightmap() {
 #endif
 }
 
+/// `path` as the report shows it: relative to the package when it lies inside it (the default
+/// heightmap), so that a committed report names no machine's build directory.
+std::string shownPath(const std::string& path) {
+#ifdef SWARMBOT3D_SOURCE_DIR
+  const std::string package = std::string(SWARMBOT3D_SOURCE_DIR) + "/";
+  if (path.compare(0, package.size(), package) == 0) return path.substr(package.size());
+#endif
+  return path;
+}
+
 /// Progress on stderr, with the seconds since the start.
 const auto g_start = std::chrono::steady_clock::now();
 void progress(const std::string& s) {
@@ -537,7 +548,7 @@ void writeFig44(std::ostream& md, const Options& o) {
   md << "## Figure 4.4 - straight motion on rough terrain\n\n"
      << "Random heading, and a random start from which the ideal path stays 15 cm inside the height field, "
         "on a 5 x 5 m height field (Fast: 2.5 x 2.5 m and half the height range, "
-        "as the seed halves its terrain) from `" << o.heightmap << "`, 10 s at 15.24 cm/s; distance projected "
+        "as the seed halves its terrain) from `" << shownPath(o.heightmap) << "`, 10 s at 15.24 cm/s; distance projected "
         "on the initial heading (ideal 1.52 m). HR is the terrain's height range in cm (the seed's simulator "
         "worked in CGS units: its tables give lengths in cm, forces in dyne; HR 1 'almost flat' to 32 'very "
         "rough', 4.2.2). " << runs << " runs per point.\n\n"
@@ -655,6 +666,10 @@ void writeTable(std::ostream& md, const v::ReferenceTable& t, const Options& o, 
   for (const std::string& p : t.after) md << builtInParagraph(p);
 }
 
+/// The first words of every scenario file --scenario writes: a file that does not start with them
+/// is someone else's and is not overwritten.
+constexpr const char* kTrialScenarioMark = "# Validation trial";
+
 /// --scenario FILE --trial KIND LEVEL PARAM: the trial's world and start as a scenario file for the
 /// simulator node, so that a cell can be watched in rviz (how, printed). Exit status as main's.
 int writeTrialScenario(const std::string& file, const v::ExperimentKind& kind, const std::string& level, double param,
@@ -670,6 +685,21 @@ int writeTrialScenario(const std::string& file, const v::ExperimentKind& kind, c
                  kind.name.c_str(), kinds.c_str());
     return 2;
   }
+  if (file.empty()) {
+    std::fprintf(stderr, "sbot_validate: --scenario expects a file name, found ''\n");
+    return 2;
+  }
+  {  // a scenario of the user's own (or any other file) under that name would be lost
+    std::ifstream existing(file);
+    std::string first;
+    if (existing && std::getline(existing, first) && first.rfind(kTrialScenarioMark, 0) != 0) {
+      std::fprintf(stderr,
+                   "sbot_validate: --scenario: %s exists and was not written by sbot_validate --scenario (its first "
+                   "line is not '%s ...'); not overwritten: remove it or choose another name\n",
+                   file.c_str(), kTrialScenarioMark);
+      return 2;
+    }
+  }
   const v::TrialWorld t = kind.world(level, param, index, drive);
   sbot::Scenario sc;
   sc.world = t.world;
@@ -681,7 +711,7 @@ int writeTrialScenario(const std::string& file, const v::ExperimentKind& kind, c
   const std::string drive_cmd = "rostopic pub -1 /sbot_0/cmd_speed sbot_msgs/TrackSpeed '{left: " +
                                 std::to_string(t.units) + ", right: " + std::to_string(t.units) + "}'";
   const std::string header =
-      "# Validation trial '" + what + "', trial " + std::to_string(index) + " of its cell (start perturbation included),\n"
+      std::string(kTrialScenarioMark) + " '" + what + "', trial " + std::to_string(index) + " of its cell (start perturbation included),\n"
       "# written by sbot_validate --scenario. To watch it:\n"
       "#   " + launch_cmd + "\n"
       "#   " + drive_cmd + "   # the trial's drive, after it stood " + fmt(t.settle, 1) + " s\n"
@@ -707,17 +737,19 @@ int main(int argc, char** argv) {
   int index = 0;  // --index: which trial of a cell --trial runs (its start perturbation)
   v::Drive drive;  // --speed: the labelled trials' setSpeed units (default: the seed's 2.8 cm/s)
   std::string scenario_file;  // --scenario: write --trial's world as a scenario file instead of running it
+  bool write_scenario = false;  // --scenario given (an empty name is refused, not taken for its absence)
   std::vector<std::string> trial_options;  // given options that only --trial reads
+  std::vector<std::string> report_options;  // given options that only a report reads
   sbot_tools::ArgReader args("sbot_validate", argc, argv);
   while (args.more()) {
     const std::string a = args.option();
-    if (a == "--out") o.out = args.value();
-    else if (a == "--quick") o.quick = true;
-    else if (a == "--trials") o.trials = args.count(1, 1000);
-    else if (a == "--jobs") o.jobs = args.count(1, 64);
-    else if (a == "--heightmap") o.heightmap = args.value();
-    else if (a == "--reasons") o.reasons = args.value();
-    else if (a == "--tables") o.tables = args.value();
+    if (a == "--out") o.out = args.value(), report_options.push_back(a);
+    else if (a == "--quick") o.quick = true, report_options.push_back(a);
+    else if (a == "--trials") o.trials = args.count(1, 1000), report_options.push_back(a);
+    else if (a == "--jobs") o.jobs = args.count(1, 64), report_options.push_back(a);
+    else if (a == "--heightmap") o.heightmap = args.value(), report_options.push_back(a);
+    else if (a == "--reasons") o.reasons = args.value(), report_options.push_back(a);
+    else if (a == "--tables") o.tables = args.value(), report_options.push_back(a);
     else if (a == "--trace") trace = true;  // with --trial (before it): the robot's state every 0.1 s
     else if (a == "--index") index = args.count(0, 999), trial_options.push_back(a);  // with --trial: the cell's trial N
     else if (a == "--speed") drive.units = args.count(1, 70), trial_options.push_back(a);  // with --trial: setSpeed units
@@ -726,9 +758,9 @@ int main(int argc, char** argv) {
       drive.track_mu = m == v::kLabFloorName ? v::kLabFloorTrackMu : sbot_tools::numberArg(args.tool(), "--track-mu", m, 1e-6, 100);
       trial_options.push_back(a);
     }
-    else if (a == "--scenario") scenario_file = args.value(), trial_options.push_back(a);  // with --trial: write, do not run
+    else if (a == "--scenario") scenario_file = args.value(), write_scenario = true, trial_options.push_back(a);  // with --trial: write, do not run
     else if (a == "--trial") {  // --trial KIND LEVEL PARAM: one trial, printed (tuning aid)
-      const std::string kind = args.value(), level = args.value();
+      const std::string kind = args.value("KIND LEVEL PARAM"), level = args.value("LEVEL PARAM after KIND");
       const v::ExperimentKind* k = v::findExperimentKind(kind);
       if (!k) {
         std::fprintf(stderr, "sbot_validate: --trial expects %s, found '%s'\n", v::experimentKindNames().c_str(), kind.c_str());
@@ -736,13 +768,22 @@ int main(int argc, char** argv) {
       }
       sbot_tools::requireLevel("sbot_validate", "--trial " + kind + " " + level, level);
       const double p = sbot_tools::numberArg(args.tool(), "--trial " + kind + " " + level + " (" + k->unit + ")",
-                                             args.value(), k->min, k->max);
+                                             args.value("PARAM after KIND LEVEL"), k->min, k->max);
+      if (args.more()) {  // options after it would be ignored: the trial runs as soon as it is read
+        std::fprintf(stderr, "sbot_validate: --trial KIND LEVEL PARAM comes last; found '%s' after it\n", args.peek().c_str());
+        return 2;
+      }
+      if (!report_options.empty()) {  // a single trial would run without them
+        std::fprintf(stderr, "sbot_validate: %s makes a report; --trial runs one trial (its own options: --trace, "
+                             "--index, --speed, --track-mu, --scenario)\n", report_options.front().c_str());
+        return 2;
+      }
       if (kind == "speed" && p != std::round(p)) {  // setSpeed takes whole units: 0.4 would drive at 0
         std::fprintf(stderr, "sbot_validate: --trial speed %s expects a whole number of setSpeed units, found %g\n",
                      level.c_str(), p);
         return 2;
       }
-      if (!scenario_file.empty()) return writeTrialScenario(scenario_file, *k, level, p, index, drive);
+      if (write_scenario) return writeTrialScenario(scenario_file, *k, level, p, index, drive);
       v::setTrace(trace);
       v::setRoughHeightmap(findHeightmap());
       const Outcome r = k->run(level, p, index, drive);
@@ -761,6 +802,7 @@ int main(int argc, char** argv) {
       std::stringstream ss(list);
       for (std::string s; std::getline(ss, s, ',');) o.only.insert(s);
     } else {
+      if (a != "--help") std::fprintf(stderr, "sbot_validate: unknown option '%s'\n", a.c_str());
       std::fprintf(stderr, "usage: sbot_validate --out DIR [--quick] [--trials N] [--jobs N] [--only LIST]\n"
                            "                     [--tables YAML] [--reasons YAML] [--heightmap PNG]\n"
                            "       sbot_validate [--trace] [--index N] [--speed UNITS] [--track-mu MU|lab_floor] --trial KIND LEVEL PARAM\n"
@@ -805,6 +847,9 @@ int main(int argc, char** argv) {
     const bool listed = std::any_of(tables.report.begin(), tables.report.end(), [&](const v::ReportEntry& e) { return e.name() == s; });
     return listed && (o.only.empty() || o.only.count(s));
   };
+  const bool heightmap_given = std::find(report_options.begin(), report_options.end(), "--heightmap") != report_options.end();
+  if (heightmap_given && !want("fig4.4"))  // a typo in it would otherwise pass unseen
+    std::fprintf(stderr, "sbot_validate: warning: --heightmap is not used: the run has no fig4.4 section\n");
   if (want("fig4.4")) {  // before any work: every rough-terrain run would fail on it
     sbot::TerrainConfig t;
     t.type = sbot::TerrainConfig::Type::Rough;
@@ -898,9 +943,28 @@ int main(int argc, char** argv) {
   for (const v::ReferenceGroup& g : tables.groups) {
     const Tally& t = tallies[g.name];
     if (g.required) required_match = required_match && t.match == t.total;
-    if (t.total == 0) continue;
-    md << "- " << g.title << " matched: " << t.str() << "\n";
-    counts += (counts.empty() ? "" : ", ") + g.name + " " + t.str();
+    // What --only left out of the tally: a "4/4" of a group with nine cells would read as all of it.
+    int cells_not_run = 0;
+    std::vector<std::string> sections_not_run;
+    for (const v::ReportEntry& e : tables.report) {
+      if (want(e.name())) continue;
+      if (e.section.empty() && e.table.group == g.name) cells_not_run += static_cast<int>(e.table.cells.size());
+      if (e.section == "4.1pair" && g.name == kHardwareGroup) sections_not_run.push_back(e.section);
+    }
+    std::string left_out;
+    if (cells_not_run > 0) left_out = std::to_string(cells_not_run) + " cells";
+    for (const std::string& sec : sections_not_run) left_out += (left_out.empty() ? "" : " and ") + ("section " + sec);
+    if (t.total == 0 && left_out.empty()) continue;
+    md << "- " << g.title << " matched: " << t.str();
+    if (!left_out.empty()) md << " (" << left_out << " of this tally not run: --only)";
+    md << "\n";
+    counts += (counts.empty() ? "" : ", ") + g.name + " " + t.str() + (left_out.empty() ? "" : " (" + left_out + " not run)");
+  }
+  if (counts.empty()) {  // every table shown, none compared: an exit status 0 would say nothing
+    md << "- No cell is tallied: no table run names a group (`group:` in the tables file), so nothing was "
+          "compared and the exit status says nothing.\n";
+    std::fprintf(stderr, "sbot_validate: warning: no cell is tallied (no table run names a group of %s)\n",
+                 tables.source.c_str());
   }
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - g_start).count();
   md << "- Wall time: " << fmt(total, 0) << " s on " << o.jobs << " processes\n";
@@ -917,8 +981,9 @@ int main(int argc, char** argv) {
     md << "- Recorded reasons whose cell now matches (remove them from `" << reasons.source()
        << "`): " << cells(reasons.stale()) << "\n";
   md << "\nReference tables: `" << tables.source << "`. Each mismatch is explained under its table (from `"
-     << reasons.source() << "`); the full analysis, with what was tried, is *Why cells do not match* in "
-        "`src/validation/README.md`.\n";
+     << reasons.source() << "`)";
+  if (o.tables.empty()) md << "; the full analysis, with what was tried, is *Why cells do not match* in `src/validation/README.md`";
+  md << ".\n";
   std::printf("%s", md.str().c_str());
   try {
     sbot::writeTextFile(o.out + "/report.md", md.str());

@@ -205,6 +205,12 @@ TEST(ReferenceTables, MalformedFilesAreRefusedWithTheEntryAndTheProblem) {
       {with("report:\n", "report:\n  - table: {id: lab1, title: x, references: [a], experiment: gap, level: fast, "
                           "cells: [{param: 0.03, a: pass}]}\n"),
         "'lab1' appears twice in the report"},
+      // Outside probe, 2026-12-02: a slope cell in a gap table read "25000 mm", a gap "0.03 deg".
+      {with("{param: 0.035, level: basic, measured: pass}", "{param: 25, experiment: slope, measured: full}"),
+        "cell 2: slope's parameter is a slope in deg, which the table's param format shows as x1000 mm"},
+      {with("unit: mm, scale: 1000", "unit: deg, scale: 1"), "gap's parameter is a gap width in m, which the table's param format shows as x1 deg"},
+      {with("unit: mm, scale: 1000", "unit: mm, scale: 100"), "shows as x100 mm"},
+      {with("param: 0.060", "param: [0.060]"), "cell 1: field 'param' must be a number, found a list"},
       {"groups: []\n", "'report' must be a non-empty list"},
       {"report: [unclosed\n", "not YAML"},
       {"- just\n- a list\n", "expected a map with 'groups' and 'report'"},

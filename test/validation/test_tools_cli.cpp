@@ -130,7 +130,8 @@ TEST(ToolsCli, BenchIdleRowsTimeStandingRobots) {
 // with an unrelated message).
 TEST(ToolsCli, AnOptionWithoutItsValueIsRefusedByName) {
   expectRefused("sbot_validate", "--out", "sbot_validate: --out needs a value");
-  expectRefused("sbot_validate", "--trial step detailed", "sbot_validate: --trial needs a value");
+  expectRefused("sbot_validate", "--trial step detailed", "sbot_validate: --trial needs PARAM after KIND LEVEL");
+  expectRefused("sbot_validate", "--trial", "sbot_validate: --trial needs KIND LEVEL PARAM");
   expectRefused("switching_experiment", "--runs 2 --scenario", "switching_experiment: --scenario needs a value");
   expectRefused("two_sbots", "--level", "two_sbots: --level needs a value");
 }
@@ -497,6 +498,45 @@ TEST(ToolsCli, ATrialIsWrittenAsAScenarioToWatch) {
                 "--scenario: a slope trial cannot be written as a scenario");
   expectRefused("sbot_validate", "--scenario /proc/sbot_no_such_place/t.yaml --trial gap detailed 0.03",
                 "--scenario: cannot write '/proc/sbot_no_such_place/t.yaml'");
+}
+
+// Outside probe, 2026-12-02: with --only a required group's tally read "1/1" of its two cells, and
+// a file whose tables name no group gave exit status 0 without a word that nothing was compared.
+TEST(ToolsCli, ATallySaysWhatOnlyLeftOutAndAnUntalliedReportSaysSo) {
+  const std::string dir = testing::TempDir() + "cli_tally/";
+  std::system(("mkdir -p " + dir).c_str());
+  const auto table = [](const std::string& id, const std::string& group) {
+    return "  - table:\n      id: " + id + "\n      title: " + id + "\n" + (group.empty() ? "" : "      group: " + group + "\n") +
+           "      experiment: gap\n      level: fast\n      param: {unit: mm, scale: 1000, decimals: 0}\n"
+           "      references: [measured]\n      cells:\n        - {param: 0.030, measured: pass}\n";
+  };
+  std::ofstream(dir + "two.yaml") << "groups:\n  - {name: lab, title: \"Lab cells\", required: true}\nreport:\n"
+                                  << table("lab1", "lab") << table("lab2", "lab");
+  const std::string tool = "--trials 1 --jobs 1 --out " + dir;
+  Outcome o = run("sbot_validate", tool + "two --tables " + dir + "two.yaml --only lab1");
+  EXPECT_EQ(o.status, 0) << o.output;
+  EXPECT_NE(o.output.find("- Lab cells matched: 1/1 (1 cells of this tally not run: --only)"), std::string::npos) << o.output;
+  std::ofstream(dir + "none.yaml") << "groups: []\nreport:\n" << table("shown", "");
+  o = run("sbot_validate", tool + "none --tables " + dir + "none.yaml");
+  EXPECT_NE(o.output.find("- No cell is tallied"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("warning: no cell is tallied"), std::string::npos) << o.output;
+}
+
+// Outside probe, 2026-12-02: what followed --trial's three values was ignored (report options too,
+// as --trials 3 with it ran one trial), an empty --scenario ran the trial instead of writing it, a
+// --scenario over a file of one's own replaced it, and an unknown option printed only the usage.
+TEST(ToolsCli, ATrialTakesOnlyItsOwnOptionsAndKeepsOtherFiles) {
+  expectRefused("sbot_validate", "--trial step detailed 0.01 extra", "--trial KIND LEVEL PARAM comes last; found 'extra' after it");
+  expectRefused("sbot_validate", "--trials 3 --trial step detailed 0.01", "--trials makes a report; --trial runs one trial");
+  expectRefused("sbot_validate", "--scenario \"\" --trial gap detailed 0.03", "--scenario expects a file name, found ''");
+  expectRefused("sbot_validate", "--bogus", "sbot_validate: unknown option '--bogus'");
+  const std::string mine = testing::TempDir() + "cli_my_scenario.yaml";
+  std::ofstream(mine) << "name: mine\n";
+  expectRefused("sbot_validate", "--scenario " + mine + " --trial gap detailed 0.03", "exists and was not written by sbot_validate");
+  std::ifstream in(mine);
+  std::string first;
+  std::getline(in, first);
+  EXPECT_EQ(first, "name: mine") << "the user's file is kept";
 }
 
 TEST(ToolsCli, AValidTrialRuns) {

@@ -7,6 +7,7 @@
 // regressions. When such a cell starts to match, the test says so: remove its reason.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -83,6 +84,22 @@ TEST(ValidationCompatibility, EveryLevelsConnectedPairStandsAtItsScaledDistance)
     const double scale = v::lengthScale(levels[i]);
     EXPECT_NEAR(r[i].value / scale, 0.147, 0.003) << levels[i] << " standing";
     EXPECT_NEAR(r[i].value2 / scale, 0.147, 0.003) << levels[i] << " after reversing";
+  }
+}
+
+TEST(ValidationCompatibility, EveryLevelReachesTheDetailedModelsSteadySpeedWithinThreePercent) {
+  // Seed 2.1.3, the first half of compatibility: at the same setSpeed on flat ground every level
+  // reaches the same steady speed within 3 % (the report's compatibility table: the Detailed model
+  // is the reference), and that speed is the API's 50 x 0.28 cm/s (Table 2.2's speed unit).
+  const std::vector<std::string>& levels = sbot::modelLevels();
+  const auto r = v::runParallel(static_cast<int>(levels.size()), 2, [&](int i) { return v::steadySpeedTrial(levels[i], 50); });
+  const auto detailed = std::find(levels.begin(), levels.end(), "detailed");
+  ASSERT_NE(detailed, levels.end());
+  const double reference = r[detailed - levels.begin()].value;
+  EXPECT_NEAR(reference, 0.14, 0.03 * 0.14) << "Detailed at setSpeed(50, 50)";
+  for (std::size_t i = 0; i < levels.size(); ++i) {
+    ASSERT_NE(r[i].label, "error") << levels[i];
+    EXPECT_NEAR(r[i].value, reference, 0.03 * reference) << levels[i] << " against the Detailed model's " << reference << " m/s";
   }
 }
 

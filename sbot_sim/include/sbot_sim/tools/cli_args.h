@@ -73,14 +73,17 @@ class ArgReader {
     option_ = argv_[++i_];
     return option_;
   }
-  /// The current option's value; missing: exit 2 with "TOOL: OPTION needs a value".
-  std::string value() {
+  /// The current option's value; missing: exit 2 with "TOOL: OPTION needs a value" (or, for an
+  /// option of several values, "TOOL: OPTION needs WHAT": "--trial needs LEVEL PARAM after KIND").
+  std::string value(const std::string& what = "a value") {
     if (!more()) {
-      std::fprintf(stderr, "%s: %s needs a value\n", tool_, option_.c_str());
+      std::fprintf(stderr, "%s: %s needs %s\n", tool_, option_.c_str(), what.c_str());
       std::exit(2);
     }
     return argv_[++i_];
   }
+  /// The next argument, not consumed (more() must be true).
+  std::string peek() const { return argv_[i_ + 1]; }
   double number(double min, double max) { return numberArg(tool_, option_, value(), min, max); }
   int count(int min, int max) { return countArg(tool_, option_, value(), min, max); }
   const char* tool() const { return tool_; }
