@@ -24,7 +24,7 @@ APT_PACKAGES=(
   libtf2-ros-dev libimage-transport-dev libcv-bridge-dev libvisualization-msgs-dev libnav-msgs-dev
   libsensor-msgs-dev libgeometry-msgs-dev libstd-srvs-dev ros-robot-state-publisher rviz
   python3-rosbag python3-rostest python3-roslaunch python3-rostopic python3-rosnode python3-rosservice
-  python3-nav-msgs python3-std-srvs python3-geometry-msgs python3-sensor-msgs python3-rospkg
+  python3-nav-msgs python3-std-srvs python3-geometry-msgs python3-sensor-msgs python3-rospkg python3-tf2-ros
   rosbash libode-dev liburdfdom-dev liburdfdom-tools libopencv-dev libeigen3-dev libyaml-cpp-dev
   libgtest-dev python3-yaml python3-numpy python3-matplotlib xvfb xauth
 )
