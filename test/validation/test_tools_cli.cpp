@@ -500,6 +500,31 @@ TEST(ToolsCli, ATrialIsWrittenAsAScenarioToWatch) {
                 "--scenario: cannot write '/proc/sbot_no_such_place/t.yaml'");
 }
 
+// Figure 4.4 end to end (--quick: 4 runs a point): the table of distances, the plot, and the
+// seed's reading checked per level, every mismatch of it with its recorded reason.
+TEST(ToolsCli, FigureFourFourHasItsTablePlotAndTheSeedsReading) {
+  const std::string dir = testing::TempDir() + "cli_fig44/";
+  const Outcome o = run("sbot_validate", "--only fig4.4 --quick --out " + dir);
+  EXPECT_EQ(o.status, 0) << o.output;
+  EXPECT_NE(o.output.find("| level | HR 1 | HR 2 | HR 4 | HR 8 | HR 16 | HR 32 |"), std::string::npos) << o.output;
+  std::ifstream png(dir + "fig4_4.png", std::ios::binary);
+  char magic[4] = {};
+  png.read(magic, 4);
+  EXPECT_EQ(std::string(magic + 1, 3), "PNG") << "the plot";
+  EXPECT_NE(o.output.find("| level | holds its course up to | the seed says | match |"), std::string::npos) << o.output;
+  for (const std::string level : {"fast", "simple", "medium"}) {
+    const auto row = o.output.find("\n| " + level + " | HR ", o.output.find("holds its course up to"));
+    ASSERT_NE(row, std::string::npos) << level << ": " << o.output;
+    const std::string line = o.output.substr(row + 1, o.output.find('\n', row + 1) - row - 1);
+    const bool mismatch = line.find("**mismatch**") != std::string::npos;
+    EXPECT_TRUE(mismatch || line.find("| match") != std::string::npos) << line;
+    if (mismatch) {
+      EXPECT_NE(o.output.find("- *fig4.4 " + level + "*: "), std::string::npos) << "its reason: " << o.output;
+    }
+  }
+  EXPECT_EQ(o.output.find("not explained yet"), std::string::npos) << o.output;
+}
+
 // Outside probe, 2026-12-02: with --only a required group's tally read "1/1" of its two cells, and
 // a file whose tables name no group gave exit status 0 without a word that nothing was compared.
 TEST(ToolsCli, ATallySaysWhatOnlyLeftOutAndAnUntalliedReportSaysSo) {
