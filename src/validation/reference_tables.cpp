@@ -265,7 +265,7 @@ ReferenceTable readTable(const YAML::Node& node, const std::string& where, const
     const double units = cf.number("speed_units", false, speed_units);
     if (units != std::round(units) || units < 1 || units > 70)
       fail(cat + ": speed_units expects a whole number of setSpeed units in [1, 70] (0.28 cm/s each), found " +
-           std::to_string(units));
+           cf.text("speed_units", false, std::to_string(static_cast<int>(units))));
     c.speed_units = static_cast<int>(units);
     c.track_mu = cf.trackMu("track_mu", track_mu);
     const ExperimentKind* kind = findExperimentKind(c.experiment);

@@ -4,7 +4,7 @@
 // parameter each cell runs, and what the hardware or the seed's simulator observed); --tables FILE
 // runs another file of the same form (reference_tables.h), e.g. your own measurements.
 //
-//   rosrun swarmbot3d sbot_validate --out DIR [--quick] [--trials N] [--jobs 2] [--only LIST]
+//   rosrun swarmbot3d sbot_validate [--out DIR] [--quick] [--trials N] [--jobs 2] [--only LIST]
 //                                   [--tables YAML] [--reasons YAML] [--heightmap PNG]
 //
 // LIST: comma-separated table ids and built-in sections of the tables file (the seed's: facts, 4.1,
@@ -803,8 +803,13 @@ int main(int argc, char** argv) {
   std::vector<std::string> trial_options;  // given options that only --trial reads
   std::vector<std::string> report_options;  // given options that only a report reads
   sbot_tools::ArgReader args("sbot_validate", argc, argv);
+  std::set<std::string> given;  // an option given twice: the second would silently replace the first
   while (args.more()) {
     const std::string a = args.option();
+    if (a.rfind("--", 0) == 0 && !given.insert(a).second) {
+      std::fprintf(stderr, "sbot_validate: %s is given twice\n", a.c_str());
+      return 2;
+    }
     if (a == "--out") o.out = args.value(), report_options.push_back(a);
     else if (a == "--quick") o.quick = true, report_options.push_back(a);
     else if (a == "--trials") o.trials = args.count(1, 1000), report_options.push_back(a);
@@ -865,7 +870,7 @@ int main(int argc, char** argv) {
       for (std::string s; std::getline(ss, s, ',');) o.only.insert(s);
     } else {
       if (a != "--help") std::fprintf(stderr, "sbot_validate: unknown option '%s'\n", a.c_str());
-      std::fprintf(stderr, "usage: sbot_validate --out DIR [--quick] [--trials N] [--jobs N] [--only LIST]\n"
+      std::fprintf(stderr, "usage: sbot_validate [--out DIR] [--quick] [--trials N] [--jobs N] [--only LIST]\n"
                            "                     [--tables YAML] [--reasons YAML] [--heightmap PNG]\n"
                            "       sbot_validate [--trace] [--index N] [--speed UNITS] [--track-mu MU|lab_floor] --trial KIND LEVEL PARAM\n"
                            "       sbot_validate --scenario FILE [--index N] [--speed UNITS] [--track-mu MU|lab_floor] --trial KIND LEVEL PARAM\n");
@@ -926,7 +931,10 @@ int main(int argc, char** argv) {
   try {  // before any work: a report whose mismatches cannot be explained is not written
     // Your own tables without --reasons: the seed's reasons are about the seed's cells, and would
     // "explain" a cell of yours that happens to share a name.
-    if (!o.reasons.empty()) reasons = v::MismatchReasons::load(o.reasons);
+    if (!o.reasons.empty()) {
+      reasons = v::MismatchReasons::load(o.reasons);
+      if (reasons.keys().empty()) std::fprintf(stderr, "sbot_validate: warning: --reasons %s holds no reasons\n", o.reasons.c_str());
+    }
     else if (o.tables.empty()) reasons = v::MismatchReasons::load(source_dir + "/" + v::kMismatchReasonsFile, v::kMismatchReasonsFile);
     else reasons = v::MismatchReasons::none();
   } catch (const std::exception& e) {

@@ -555,6 +555,7 @@ TEST(ToolsCli, ATrialTakesOnlyItsOwnOptionsAndKeepsOtherFiles) {
   expectRefused("sbot_validate", "--trials 3 --trial step detailed 0.01", "--trials makes a report; --trial runs one trial");
   expectRefused("sbot_validate", "--scenario \"\" --trial gap detailed 0.03", "--scenario expects a file name, found ''");
   expectRefused("sbot_validate", "--bogus", "sbot_validate: unknown option '--bogus'");
+  expectRefused("sbot_validate", "--tables a.yaml --tables b.yaml", "sbot_validate: --tables is given twice");
   const std::string mine = testing::TempDir() + "cli_my_scenario.yaml";
   std::ofstream(mine) << "name: mine\n";
   expectRefused("sbot_validate", "--scenario " + mine + " --trial gap detailed 0.03", "exists and was not written by sbot_validate");
