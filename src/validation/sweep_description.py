@@ -134,8 +134,9 @@ def summary(report_md):
     """'hardware 12/16, 4.5 21/28, ...' (every group the report tallies) and its mismatched rows."""
     with open(report_md, encoding="utf-8") as fh:
         text = fh.read()
-    counts = re.findall(r"^- (.+) matched: (\d+/\d+)$", text, re.M)
-    tally = ", ".join("%s %s" % (SHORT_NAMES.get(n, n), c) for n, c in counts)
+    # A tally may end in "(N cells of this tally not run: --only)"; one that ran none is left out.
+    counts = re.findall(r"^- (.+) matched: (\d+/\d+)(?: \(.*\))?$", text, re.M)
+    tally = ", ".join("%s %s" % (SHORT_NAMES.get(n, n), c) for n, c in counts if not c.endswith("/0"))
     missed = [" | ".join(c.strip() for c in row.strip().strip("|").split("|") if "mismatch" not in c)
               for row in text.splitlines() if row.startswith("| ") and "**mismatch**" in row]
     return tally, missed
