@@ -122,6 +122,9 @@ std::string channelRangeProblem(const std::string& channel, double v) {
          "]" + unit;
 }
 
+/// [s] the latest start of a run in its session (Run::start_time): 10 days.
+constexpr double kMaxStartTime = 864000;
+
 bool parseNumber(const std::string& cell, double& out) {
   if (cell.empty()) return false;
   const char* b = cell.c_str();
@@ -678,6 +681,12 @@ Dataset loadDatasetFields(const std::string& path_in) {
       run.initial_pose.x = number(p["x"], f, field + ".initial_pose.x");
       run.initial_pose.y = number(p["y"], f, field + ".initial_pose.y");
       run.initial_pose.yaw = number(p["yaw"], f, field + ".initial_pose.yaw");
+      // The measured channels' own bounds (channelRangeProblem): a start the world cannot place was
+      // named only by the first replay, without the file or the field.
+      const std::pair<const char*, double> start[] = {
+          {"x", run.initial_pose.x}, {"y", run.initial_pose.y}, {"yaw", run.initial_pose.yaw}};
+      for (const auto& [k, v] : start)
+        if (const std::string why = channelRangeProblem(k, v); !why.empty()) fail(f, p[k], field + ".initial_pose." + k, why);
     } else if (run.kind == RunKind::Drive) {
       fail(f, r, field + ".initial_pose", "missing (a drive run starts from a known pose)");
     }
@@ -685,6 +694,9 @@ Dataset loadDatasetFields(const std::string& path_in) {
     if (r["start_time"]) {
       run.start_time = number(r["start_time"], f, field + ".start_time");
       if (run.start_time < 0) fail(f, r["start_time"], field + ".start_time", "must be >= 0");
+      if (run.start_time > kMaxStartTime)  // a battery's time, not a date: 1e300 s drained it at once
+        fail(f, r["start_time"], field + ".start_time",
+             "must be at most " + fmtNumber(kMaxStartTime) + " s (a time in the session, not a date)");
     }
     run.path = run.file[0] == '/' ? run.file : ds.dir + "/" + run.file;
     parseRunCsv(readFile(run.path, f, r["file"]), run.path, run);

@@ -142,6 +142,8 @@ Args parse(int argc, char** argv) {
       s = s.substr(2);
       const auto eq = s.find('=');
       if (eq != std::string::npos) {
+        if (kFlags.count(s.substr(0, eq)))  // --no-align=false used to turn alignment off
+          throw std::invalid_argument("--" + s.substr(0, eq) + " is a flag and takes no value, found '" + argv[i] + "'");
         a.opts.emplace(s.substr(0, eq), s.substr(eq + 1));
       } else if (kFlags.count(s)) {
         a.flags.insert(s);
@@ -239,6 +241,21 @@ void checkOutputPlace(const std::string& option, const std::string& path, bool d
     throw OutputError("--" + option + ": " + e.what());
   }
   g_created_dirs.insert(g_created_dirs.end(), missing.begin(), missing.end());
+}
+
+/// An output file of `--option` that is one of the dataset's own files (its dataset.yaml, a run's
+/// CSV) is refused: `fit --out DATASET/dataset.yaml` replaced the dataset with an effects file.
+void refuseDatasetFile(const std::string& option, const std::string& path, const Dataset& ds) {
+  char out[PATH_MAX];
+  if (!::realpath(path.c_str(), out)) return;  // a new file is nobody's input
+  std::vector<std::string> inputs{ds.yaml_path};
+  for (const Run& r : ds.runs) inputs.push_back(r.path);
+  for (const std::string& input : inputs) {
+    char in[PATH_MAX];
+    if (::realpath(input.c_str(), in) && std::strcmp(in, out) == 0)
+      throw OutputError("--" + option + ": '" + path + "' is the dataset's own " + input +
+                        "; write the result elsewhere (the dataset is the measurement)");
+  }
 }
 
 /// A folder with something in it (a dataset written there would overwrite and mix with its files).
@@ -401,7 +418,10 @@ int cmdDiagnose(const Args& a) {
   if (a.has("candidates")) o.candidates = namedCandidates(measured, a);
   o.progress = !a.has("quiet");
   if (a.has("verbose")) o.log = [](const std::string& s) { std::fprintf(stderr, "%s\n", s.c_str()); };
-  if (a.has("write-effects")) checkOutputPlace("write-effects", a.get("write-effects"), false);
+  if (a.has("write-effects")) {
+    refuseDatasetFile("write-effects", a.get("write-effects"), measured);
+    checkOutputPlace("write-effects", a.get("write-effects"), false);
+  }
   WorkerPool& pool = WorkerPool::global();
   // On the runs the start model replays reproducibly, and again with those the diagnosed model
   // replays too (evaluation.h, solveOnReplayableRuns).
@@ -502,6 +522,7 @@ int cmdFit(const Args& a) {
   }
   FitOptions fo;
   fo.max_iterations = static_cast<int>(a.whole("max-iterations", fo.max_iterations, 1, 1000, "Levenberg-Marquardt iterations"));
+  refuseDatasetFile("out", a.get("out"), measured);
   checkOutputPlace("out", a.get("out"), false);
   WorkerPool& pool = WorkerPool::global();
   std::size_t evals = 0;

@@ -294,6 +294,25 @@ TEST(Cli, FitAndDiagnoseOutputsAreTriedBeforeTheWorkAndARefusedRunCreatesNoFolde
   EXPECT_FALSE(exists(dir + "made")) << "the refused run created the folder of its --write-effects";
 }
 
+// Outside probe, 2026-12-02: `fit --out DATASET/dataset.yaml` replaced the dataset with an effects
+// file, `diagnose --write-effects` a run's CSV, and `--no-align=false` turned alignment off.
+TEST(Cli, TheDatasetsOwnFilesAreNotOverwrittenAndFlagsTakeNoValue) {
+  const std::string dir = freshDir("cli_own_files");
+  std::system(("cp -r " + kIrPoints + " " + dir + "ds").c_str());
+  const std::string yaml = readFile(dir + "ds/dataset.yaml");
+  const Outcome fit = run("fit " + dir + "ds --effect ir_reflectance --quiet --out " + dir + "ds/dataset.yaml");
+  EXPECT_EQ(fit.status, 1) << fit.output;
+  EXPECT_TRUE(contains(fit.output, "--out: '" + dir + "ds/dataset.yaml' is the dataset's own")) << fit.output;
+  EXPECT_EQ(readFile(dir + "ds/dataset.yaml"), yaml) << "the dataset is kept";
+  const Outcome diag = run("diagnose " + dir + "ds/ --quiet --write-effects " + dir + "ds/../ds/dataset.yaml");
+  EXPECT_EQ(diag.status, 1) << diag.output;
+  EXPECT_TRUE(contains(diag.output, "--write-effects: ")) << diag.output;
+  EXPECT_EQ(readFile(dir + "ds/dataset.yaml"), yaml) << "the dataset is kept";
+  const Outcome flag = run("compare " + dir + "ds --no-align=false --out " + dir + "report");
+  EXPECT_EQ(flag.status, 1) << flag.output;
+  EXPECT_TRUE(contains(flag.output, "--no-align is a flag and takes no value, found '--no-align=false'")) << flag.output;
+}
+
 // The effects library's loader took a stderr key that is no parameter and a surface no dataset can
 // have: both would be dropped without a word.
 TEST(Cli, AnEffectsFileWithAnUnknownSurfaceOrStderrKeyIsRefused) {

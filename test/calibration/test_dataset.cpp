@@ -309,6 +309,15 @@ TEST(Dataset, RunNamesStartPosesAndSegmentsAreChecked) {
   e = errorOf(makeDataset("segment", csv, "align_segment: 0.05\n" + std::string(kYaml)));
   EXPECT_NE(std::string(e.what()).find("at least 1 s"), std::string::npos) << e.what();
   EXPECT_NO_THROW(loadDataset(makeDataset("segment_ok", csv, "align_segment: 0\n" + std::string(kYaml))));
+  // Outside probe, 2026-12-02: a start the world cannot place was named by the first replay only,
+  // without file or field; a start time of 1e300 s drained the battery model at once.
+  e = errorOf(makeDataset("far", csv, withRun("  - {name: s, file: straight.csv, initial_pose: {x: 1e9, y: 0, yaw: 0}}\n")));
+  EXPECT_NE(std::string(e.what()).find("runs[0].initial_pose.x': value 1e+09 outside the range of x"), std::string::npos) << e.what();
+  e = errorOf(makeDataset("spun", csv, withRun("  - {name: s, file: straight.csv, initial_pose: {x: 0, y: 0, yaw: 1e6}}\n")));
+  EXPECT_NE(std::string(e.what()).find("runs[0].initial_pose.yaw"), std::string::npos) << e.what();
+  e = errorOf(makeDataset("late", csv, withRun("  - {name: s, file: straight.csv, start_time: 1e300, "
+                                                "initial_pose: {x: 0, y: 0, yaw: 0}}\n")));
+  EXPECT_NE(std::string(e.what()).find("runs[0].start_time"), std::string::npos) << e.what();
 }
 
 }  // namespace
