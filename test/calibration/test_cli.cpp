@@ -349,6 +349,16 @@ TEST(Cli, RunsTheModelCannotReplayAreNamedAndLeftOut) {
   // straight_20/40/60 and the two arcs.
   const std::string skipped = expectRun(fit + "skipped.yaml", 0, {"leaving out ", "arc_right", "fit on "});
   EXPECT_FALSE(contains(skipped, "fit on 5 runs")) << skipped;
+  // Its error figure is over the runs it fitted; the one compare will report, over all five, is
+  // printed beside it and agrees with compare of the fitted file.
+  const std::string all_runs = " on all 5 runs (what compare reports)";
+  ASSERT_TRUE(contains(skipped, all_runs)) << skipped;
+  const std::string before_all = skipped.substr(0, skipped.find(all_runs));
+  const std::string fit_figures = before_all.substr(before_all.rfind("; ") + 2);  // "a -> b"
+  const std::string compared = expectRun("compare " + dir + "fast --effects " + dir + "skipped.yaml --no-plots --quiet --out " +
+                                             dir + "c_skipped", 0, {"error change (nRMS): "});
+  const std::size_t at = compared.find("error change (nRMS): ") + std::string("error change (nRMS): ").size();
+  EXPECT_EQ(compared.substr(at, fit_figures.size()), fit_figures) << skipped << "\n" << compared;
   expectRun(fit + "kept.yaml --keep-chaotic", 0,
             {"note: the start model does not reproduce these runs", "kept (--keep-chaotic)", "fit on 5 runs"});
   // straight_60 reads 1.0 from one side of its start, right at the bar: named with the arcs.
