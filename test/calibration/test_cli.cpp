@@ -145,6 +145,24 @@ TEST(Cli, AFitStoppedByItsIterationLimitGivesNoInterval) {
   EXPECT_TRUE(contains(bad.output, "--max-iterations")) << bad.output;
 }
 
+// The error a fit ends with is the error compare finds with the file it wrote: the file used to
+// hold 8 digits, and the replay is chaotic enough that they moved it (fit 2.3969, compare 2.4041).
+TEST(Cli, WhatAFitReportsIsWhatCompareOfItsFileReports) {
+  const std::string dir = freshDir("cli_fit_compare");
+  const Outcome fit = run("fit " + kExample + " --effect latency --effect track_width --max-iterations 1 --quiet --out " +
+                          dir + "cut.yaml");
+  ASSERT_EQ(fit.status, 0) << fit.output;
+  const std::string label = "normalised RMS: ";
+  ASSERT_TRUE(contains(fit.output, label)) << fit.output;
+  const std::string figures = fit.output.substr(fit.output.find(label) + label.size(), std::string("3.8873 -> 2.3969").size());
+  const Outcome compare = run("compare " + kExample + " --effects " + dir + "cut.yaml --no-plots --quiet --out " + dir + "c");
+  ASSERT_EQ(compare.status, 0) << compare.output;
+  const std::string change = "error change (nRMS): ";
+  ASSERT_TRUE(contains(compare.output, change)) << compare.output;
+  EXPECT_EQ(compare.output.substr(compare.output.find(change) + change.size(), figures.size()), figures)
+      << fit.output << "\n" << compare.output;
+}
+
 // An effect on channels the dataset does not measure used to be "fitted" (exponent = 0 +- 1e+06)
 // or screened without a word.
 TEST(Cli, AnEffectOnChannelsTheDatasetDoesNotMeasureIsRefusedOrNoted) {

@@ -1,11 +1,13 @@
 #include "sbot_sim/core/effects/effects_file.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <set>
 #include <sstream>
+#include <string_view>
 
 #include <sys/stat.h>
 #include <yaml-cpp/yaml.h>
@@ -160,23 +162,31 @@ std::string effectsToYaml(const std::vector<EffectConfig>& configs, const std::s
     return o.str();
   }
   o << "effects:\n";
-  o << std::setprecision(8);
-  auto map = [&o](const std::map<std::string, double>& m) {
-    o << "{";
+  // digits 0: the shortest text that reads back as the same double.
+  auto map = [&o](const std::map<std::string, double>& m, int digits) {
+    o << std::setprecision(digits) << "{";
     bool first = true;
     for (const auto& [k, v] : m) {
-      o << (first ? "" : ", ") << k << ": " << v;
+      o << (first ? "" : ", ") << k << ": ";
+      if (digits > 0) {
+        o << v;
+      } else {
+        char text[32];
+        o << std::string_view(text, std::to_chars(text, text + sizeof text, v).ptr - text);
+      }
       first = false;
     }
     o << "}";
   };
   for (const auto& c : configs) {
     o << "  - name: " << c.name << "\n    params: ";
-    map(c.params);
+    // Every digit: a replay is chaotic enough that the 8 digits written before moved a fitted
+    // Simple's error by 0.3 % (2.3969 in the fit, 2.4041 in compare of its file).
+    map(c.params, 0);
     o << "\n";
     if (!c.stderr_.empty()) {
       o << "    stderr: ";
-      map(c.stderr_);
+      map(c.stderr_, 8);
       o << "\n";
     }
     if (!c.note.empty()) o << "    note: " << YAML::Node(c.note) << "\n";
