@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iomanip>
@@ -27,12 +28,40 @@
 namespace sbot::calib {
 namespace {
 
+/// A column name as a message shows it: at most 40 characters (a header that is one 10 kB cell).
+std::string shownName(const std::string& name) { return name.size() <= 40 ? name : name.substr(0, 40) + "..."; }
+
 std::string location(const std::string& file, int line, int column, const std::string& column_name) {
   std::string s = file;
   if (line > 0) s += ":" + std::to_string(line);
   if (column > 0) s += ":" + std::to_string(column);
-  if (!column_name.empty()) s += " (column '" + column_name + "')";
+  if (!column_name.empty()) s += " (column '" + shownName(column_name) + "')";
   return s;
+}
+
+/// The first byte no text CSV holds: NUL, or a control character other than tab, CR and LF
+/// (binary and compressed files have them within their first bytes). Bytes >= 0x80 pass: a Latin-1
+/// comment in a user column is still text.
+struct NonTextByte {
+  int line = 0;            ///< 1-based; 0: none found
+  std::size_t byte = 0;    ///< 1-based within its line
+  unsigned char value = 0;
+};
+NonTextByte firstNonTextByte(const std::string& text) {
+  NonTextByte b{1, 0, 0};
+  std::size_t line_start = 0;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c == '\n') {
+      ++b.line;
+      line_start = i + 1;
+    } else if ((c < 0x20 && c != '\t' && c != '\r') || c == 0x7f) {
+      b.byte = i - line_start + 1;
+      b.value = c;
+      return b;
+    }
+  }
+  return {};
 }
 
 [[noreturn]] void fail(const std::string& file, const YAML::Node& n, const std::string& field, const std::string& what) {
@@ -318,6 +347,12 @@ std::string timeUnitProblem(const Run& run, std::vector<double> row_gaps) {
 void parseRunCsv(const std::string& text, const std::string& file, Run& run) {
   // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first column's name.
   const bool bom = text.rfind("\xEF\xBB\xBF", 0) == 0;
+  if (const NonTextByte b = firstNonTextByte(text); b.line > 0) {
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "0x%02x", b.value);
+    throw DatasetError(file, b.line, 0, "", "not a text CSV file: byte " + std::to_string(b.byte) + " of the line is " +
+                                                hex + ", a control character no text holds (a binary or compressed file?)");
+  }
   std::istringstream in(bom ? text.substr(3) : text);
   std::string raw;
   int line_no = 0;

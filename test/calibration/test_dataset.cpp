@@ -153,7 +153,21 @@ TEST(Dataset, NaNAndGarbageCells) {
   // command between API units, which setSpeed cannot have been given.
   e = errorOf(makeDataset("nul", std::string("t,cmd_left,cmd_right,x\n0,20\0,1,0\n", 33)));
   EXPECT_EQ(e.line(), 2);
-  EXPECT_EQ(e.columnName(), "cmd_left");
+  EXPECT_NE(std::string(e.what()).find("straight.csv:2: not a text CSV file: byte 5 of the line is 0x00"), std::string::npos)
+      << e.what();
+  // A binary file was reported as an unknown column named by its raw bytes (2026-12-02).
+  std::string binary = "\x1f\x8b\x08";  // a gzip header
+  for (int i = 0; i < 200; ++i) binary += static_cast<char>((i * 37) % 256);
+  e = errorOf(makeDataset("binary", binary));
+  EXPECT_EQ(e.line(), 1);
+  EXPECT_EQ(e.columnName(), "");
+  EXPECT_NE(std::string(e.what()).find("byte 1 of the line is 0x1f"), std::string::npos) << e.what();
+  // A long unknown column name is shown cut to 40 characters (the error keeps it whole).
+  e = errorOf(makeDataset("longname", "t,cmd_left,cmd_right," + std::string(100, 'q') + "\n0,1,1,0\n"));
+  EXPECT_EQ(e.columnName(), std::string(100, 'q'));
+  EXPECT_NE(std::string(e.what()).find("(column '" + std::string(40, 'q') + "...')"), std::string::npos) << e.what();
+  // Tabs, CR LF ends and Latin-1 bytes in a user column are text.
+  EXPECT_NO_THROW(loadDataset(makeDataset("text", "t,cmd_left,cmd_right,x,_note\r\n0,\t1,1,0,caf\xe9\r\n")));
   e = errorOf(makeDataset("halfunit", "t,cmd_left,cmd_right,x\n0,20.5,1,0\n"));
   EXPECT_EQ(e.columnName(), "cmd_left");
   EXPECT_NE(std::string(e.what()).find("command 20.5 is not a whole number of API units"), std::string::npos) << e.what();
