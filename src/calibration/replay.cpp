@@ -354,13 +354,25 @@ RunPrediction replayDrive(World& world, const RobotDescription& d, const Dataset
   return out;
 }
 
+/// The robot settled once on an open floor far from everything, and the resting height of its
+/// base_link there.
+std::pair<Robot*, double> settledFarAway(World& world, const RobotDescription& d) {
+  Robot& robot = world.addRobot(d, {1000.0, 1000.0, 0.0}, "sbot_0");
+  world.stepN(30);
+  return {&robot, robot.basePose().position.z() - world.terrainHeight(1000.0, 1000.0)};
+}
+
+/// Where a placement puts base_link: `z` above the terrain, or resting (rest_z) when not given.
+Pose placedPose(const World& world, const Pose2D& pose, double z, double rest_z) {
+  const double ground = world.terrainHeight(pose.x, pose.y);
+  return Pose(Vec3(pose.x, pose.y, ground + (std::isnan(z) ? rest_z : z)), quatFromRPY(0, 0, pose.yaw));
+}
+
 RunPrediction replayPlace(World& world, const RobotDescription& d, const Dataset& ds, const Run& run,
                           const ReplayOptions&) {
   RunPrediction out;
-  // Settle once on an open floor far from everything to learn the resting height of base_link.
-  Robot& robot = world.addRobot(d, {1000.0, 1000.0, 0.0}, "sbot_0");
-  world.stepN(30);
-  const double rest_z = robot.basePose().position.z() - world.terrainHeight(1000.0, 1000.0);
+  const auto [robot_ptr, rest_z] = settledFarAway(world, d);
+  Robot& robot = *robot_ptr;
   SensorBridge bridge(world, robot, ds);
   for (const auto& [c, s] : run.channels) {
     out.values[c].assign(s.t.size(), kNaN);
@@ -375,9 +387,7 @@ RunPrediction replayPlace(World& world, const RobotDescription& d, const Dataset
   std::set<std::string> absent;
   for (std::size_t row = 0; row < run.placements.size(); ++row) {
     const Placement& pl = run.placements[row];
-    const double ground = world.terrainHeight(pl.pose.x, pl.pose.y);
-    const double z = ground + (std::isnan(pl.z) ? rest_z : pl.z);
-    robot.setBasePose(Pose(Vec3(pl.pose.x, pl.pose.y, z), quatFromRPY(0, 0, pl.pose.yaw)));
+    robot.setBasePose(placedPose(world, pl.pose, pl.z, rest_z));
     bridge.placed();
     for (const auto& [c, s] : run.channels) {
       for (std::size_t i = 0; i < s.t.size(); ++i) {
@@ -471,6 +481,36 @@ WorldConfig replayWorldConfig(const Dataset& ds, const RobotDescription& level, 
   if (!ds.world_sets_step) wc.step = level.recommended_step;
   if (!ds.world_sets_gravity) wc.gravity = level.gravity;
   return wc;
+}
+
+std::string impossiblePlacement(const Dataset& ds, const std::string& level) {
+  const RobotDescription& d = loadLevel(level.empty() ? ds.robot : level);
+  World world(replayWorldConfig(ds, d, ReplayOptions()));
+  const auto [robot, rest_z] = settledFarAway(world, d);
+  auto problemAt = [&](const Run& run, const std::string& which, const Pose2D& pose, double z) -> std::string {
+    robot->setBasePose(placedPose(world, pose, z, rest_z));
+    const World::Overlap o = world.deepestOverlap(*robot);
+    if (o.depth <= World::kPlacementTolerance) return "";
+    std::ostringstream why;
+    why << run.path << ": run '" << run.name << "', " << which << " (x " << pose.x << " m, y " << pose.y << " m, yaw "
+        << pose.yaw << " rad";
+    if (!std::isnan(z)) why << ", z " << z << " m";
+    why << "): a " << d.level << " s-bot there would sit " << o.depth << " m deep inside " << o.with << " (at most "
+        << World::kPlacementTolerance << " m): no robot can have been measured there";
+    return why.str();
+  };
+  for (const Run& run : ds.runs) {
+    if (run.kind == RunKind::Drive) {
+      if (std::string why = problemAt(run, "start pose", run.initial_pose, kNaN); !why.empty()) return why;
+      continue;
+    }
+    for (std::size_t row = 0; row < run.placements.size(); ++row)
+      if (std::string why = problemAt(run, "placement " + std::to_string(row + 1), run.placements[row].pose,
+                                      run.placements[row].z);
+          !why.empty())
+        return why;
+  }
+  return "";
 }
 
 RunPrediction replayRun(const Dataset& ds, const Run& run, const ModelSpec& model, const ReplayOptions& opt) {

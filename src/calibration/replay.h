@@ -57,6 +57,12 @@ RunPrediction replayRun(const Dataset& ds, const Run& run, const ModelSpec& mode
 /// recommended step and gravity unless the dataset wrote its own (Dataset::world_sets_*).
 WorldConfig replayWorldConfig(const Dataset& ds, const RobotDescription& level, const ReplayOptions& opt);
 
+/// Why a start pose or a placement of the dataset is not a place a `level` robot can be: the robot
+/// there would sit deeper than World::kPlacementTolerance inside the ground (a place run's z below
+/// the resting height) or an obstacle, naming the run, the row and the pose; "" if every one is.
+/// Replayed, such a robot is thrown out by the contacts (drive) or reads the inside of a wall (place).
+std::string impossiblePlacement(const Dataset& ds, const std::string& level);
+
 /// True when the core can simulate this channel (sensor modules present for ir/ground/light).
 bool canSimulateChannel(const std::string& channel);
 

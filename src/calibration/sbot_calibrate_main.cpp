@@ -324,6 +324,7 @@ std::vector<EffectConfig> effectsOption(const Dataset& ds, const Args& a) {
 ModelSpec baseModel(const Dataset& ds, const Args& a) {
   ModelSpec m{a.get("level", ds.robot), {}};
   loadLevel(m.level);  // an unknown level is named now, not by the first replay
+  if (const std::string why = impossiblePlacement(ds, m.level); !why.empty()) throw std::invalid_argument(why);
   if (a.has("effects")) m.effects = effectsOption(ds, a);
   return m;
 }
@@ -464,6 +465,15 @@ int cmdDiagnose(const Args& a) {
     }
   }
   std::printf("\n%s", r.verdict.c_str());
+  if (!rounds.left_out.empty()) {
+    // The verdict is on the runs kept: what only the runs left out show was not looked at, and
+    // those may be the runs that show the missing effect best (a Fast latency shows in its spins).
+    std::string names;
+    for (const auto& n : rounds.left_out) names += (names.empty() ? "" : ", ") + n;
+    std::printf("  on %zu of %zu runs: %s %s left out as not reproducible, and what only they show is not in this "
+                "verdict; read their plots (compare) or see what a fit to them finds (--keep-chaotic)\n",
+                ds.runs.size(), measured.runs.size(), names.c_str(), rounds.left_out.size() == 1 ? "was" : "were");
+  }
   std::printf("diagnose took %.1f s wall, %d run simulations, %d worker process%s", r.seconds, r.simulations, pool.size(),
               pool.size() == 1 ? "" : "es");
   if (results.size() > 1)

@@ -385,6 +385,11 @@ TEST(Cli, RunsTheModelCannotReplayAreNamedAndLeftOut) {
   // Only chaotic runs: nothing would be left, so they are kept, and that is said.
   expectRun(fit + "arcs.yaml --skip-runs straight_20,straight_40,straight_60", 0,
             {"kept (every run is: nothing would be left to fit)", "fit on 2 runs"});
+  // diagnose's verdict says it is on the runs kept, and which were not looked at.
+  expectRun("diagnose " + dir + "fast --candidates speed_scale,latency --quiet", 0,
+            {" of 5 runs: ", "arc_left", "left out as not reproducible, and what only they show is not in this verdict"});
+  const std::string kept = expectRun("diagnose " + dir + "fast --candidates speed_scale,latency --quiet --keep-chaotic", 0, {"VERDICT"});
+  EXPECT_FALSE(contains(kept, "not in this verdict")) << kept;
   expectRun("compare " + dir + "fast --no-plots --quiet --skip-runs arc_left,spiral --out " + dir + "c", 1,
             {"has no run named spiral (its runs: "});
   expectRun(fit + "all.yaml --skip-runs arc_left,arc_right,straight_20,straight_40,straight_60", 1, {"leaves dataset"});

@@ -334,5 +334,37 @@ TEST(Dataset, RunNamesStartPosesAndSegmentsAreChecked) {
   EXPECT_NE(std::string(e.what()).find("runs[0].start_time"), std::string::npos) << e.what();
 }
 
+// A robot measured inside a wall or below the floor was replayed without a word (outside probe,
+// 2026-12-02): a drive start thrown out by the contacts, IR read from inside the wall.
+TEST(Dataset, PlacesNoRobotCanHaveBeenMeasuredAtAreNamed) {
+  const std::string drive_csv = "t,cmd_left,cmd_right,x\n0,1,1,0\n";
+  const auto withRun = [](const std::string& run) {
+    std::string yaml = kYaml;  // a wall 2 cm thick centred at x = 0.5 m, 1 m long, 10 cm high
+    return yaml.substr(0, yaml.find("  - {name: straight")) + run;
+  };
+  const auto startAt = [&](double x) {
+    return loadDataset(makeDataset("start_" + std::to_string(static_cast<int>(x * 1000)), drive_csv,
+                                   withRun("  - {name: straight, file: straight.csv, initial_pose: {x: " + std::to_string(x) +
+                                           ", y: 0, yaw: 0}}\n")));
+  };
+  EXPECT_EQ(impossiblePlacement(startAt(0.0), "simple"), "");
+  EXPECT_EQ(impossiblePlacement(startAt(0.40), "simple"), "") << "a start beside the wall is a start";
+  const std::string inside = impossiblePlacement(startAt(0.46), "simple");
+  EXPECT_NE(inside.find("run 'straight', start pose (x 0.46 m"), std::string::npos) << inside;
+  EXPECT_NE(inside.find("deep inside box 'wall'"), std::string::npos) << inside;
+
+  const std::string d = makeDataset("placements", drive_csv,
+                                    withRun("  - {name: held, file: held.csv, kind: place}\n"));
+  write(d + "/held.csv", "x,y,yaw,z,ir0\n0.30,0,0,,100\n0.47,0,0,,100\n");
+  const std::string into_wall = impossiblePlacement(loadDataset(d), "simple");
+  EXPECT_NE(into_wall.find("run 'held', placement 2 (x 0.47 m"), std::string::npos) << into_wall;
+  write(d + "/held.csv", "x,y,yaw,z,ir0\n0.30,0,0,0.2,100\n0.30,0,0,-0.05,100\n");
+  const std::string below = impossiblePlacement(loadDataset(d), "simple");
+  EXPECT_NE(below.find("placement 2 (x 0.3 m, y 0 m, yaw 0 rad, z -0.05 m)"), std::string::npos) << below;
+  EXPECT_NE(below.find("deep inside the ground"), std::string::npos) << below;
+  // The seed's IR points put a Medium's sensor 5 mm from the wall: a place, every one of them.
+  EXPECT_EQ(impossiblePlacement(loadDataset(std::string(SWARMBOT3D_SOURCE_DIR) + "/datasets/seed_ir_response"), ""), "");
+}
+
 }  // namespace
 }  // namespace sbot::calib
