@@ -1,6 +1,8 @@
 // Scenario parsing: valid files produce the robots; malformed ones name the file and the field.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/scenario.h"
@@ -197,6 +199,41 @@ TEST(Scenario, PositionsOutsideTheSimulatedSpaceAreRefused) {
   c.terrain.type = TerrainConfig::Type::Composite;
   c.terrain.boxes.push_back({"huge", Vec3(0, 0, 0), Vec3(1e300, 1, 1), 0, 0, "ground"});
   EXPECT_THROW(World{c}, ConfigError);
+}
+
+// A robot is dropped onto the highest ground under its own outline. Under its axis-aligned box it
+// was, and a Simple 0.5-2 cm clear of a wall at 45 deg had a corner of that box over the wall: it
+// was spawned 10 cm up, at the wall's height, and fell beside it.
+TEST(Scenario, ARobotBesideADiagonalWallSpawnsOnTheFloorUnlessItsOutlineIsOverIt) {
+  int beside = 0, over = 0;
+  for (const std::string level : {"simple", "medium", "detailed"}) {
+    const double open_floor_z = World(WorldConfig{}).addRobot(loadLevel(level), {0, 0, 0}, "a").basePose().position.z();
+    for (double face : {0.065, 0.07, 0.08, 0.09}) {  // [m] the wall's face from the robot's centre, along (1, 1)
+      WorldConfig c;
+      BoxObstacle wall;
+      wall.name = "wall";
+      wall.size = Vec3(0.02, 1.0, 0.1);
+      wall.yaw = M_PI / 4;
+      wall.center = Vec3(1, 1, 0) * ((face + 0.01) / std::sqrt(2.0)) + Vec3(0, 0, 0.05);
+      c.terrain.boxes.push_back(wall);
+      World w(c);
+      Robot& r = w.addRobot(loadLevel(level), {0, 0, 0}, "a");
+      const double spawned_z = r.basePose().position.z();
+      Pose on_floor = r.basePose();
+      on_floor.position.z() = open_floor_z;
+      r.setBasePose(on_floor);
+      const bool overlaps_on_floor = w.deepestOverlap(r).depth > 0;
+      if (overlaps_on_floor) {
+        ++over;
+        EXPECT_GT(spawned_z, open_floor_z + 0.09) << level << ", face " << face << ": over the wall, set on its top";
+      } else {
+        ++beside;
+        EXPECT_NEAR(spawned_z, open_floor_z, 1e-9) << level << ", face " << face << ": clear of the wall, on the floor";
+      }
+    }
+  }
+  EXPECT_GT(beside, 0);
+  EXPECT_GT(over, 0) << "the Medium's and Detailed's corners reach a wall 6.5 cm away";
 }
 
 // /sim/set_pose put a robot 5 m under the floor and reported success; it then rose through the

@@ -44,7 +44,9 @@ class World {
   World(const World&) = delete;
   World& operator=(const World&) = delete;
 
-  /// Spawn a robot of `description` with base_link at `pose` (x, y, yaw) resting on the terrain.
+  /// Spawn a robot of `description` with base_link at `pose` (x, y, yaw), level, its lowest point
+  /// 1 mm above the highest ground under its collision geoms' own outlines (a robot whose outline
+  /// reaches over a wall is set on the wall's height, as a robot held there would be).
   Robot& addRobot(const RobotDescription& description, const Pose2D& pose, const std::string& name);
   /// Spawn at an explicit 3D pose of base_link. Both refuse (ConfigError) a duplicate or invalid name.
   Robot& addRobotAt(const RobotDescription& description, const Pose& pose, const std::string& name);
