@@ -487,8 +487,18 @@ std::string impossiblePlacement(const Dataset& ds, const std::string& level) {
   const RobotDescription& d = loadLevel(level.empty() ? ds.robot : level);
   World world(replayWorldConfig(ds, d, ReplayOptions()));
   const auto [robot, rest_z] = settledFarAway(world, d);
+  // A drive run's robot stands on the terrain, so it is set along the ground's local slope (a start
+  // on a 20 deg ramp set level sat 1.5 cm inside it); a placement is replayed level, as placed.
+  auto onTheSlope = [&](const Pose2D& pose) {
+    constexpr double kHalfBase = 0.03;  // [m] finite-difference half base for the ground's gradient
+    auto h = [&](double dx, double dy) { return world.terrainHeight(pose.x + dx, pose.y + dy); };
+    const Vec3 normal = Vec3(-(h(kHalfBase, 0) - h(-kHalfBase, 0)), -(h(0, kHalfBase) - h(0, -kHalfBase)),
+                             2 * kHalfBase).normalized();
+    const Quat tilt = Quat::FromTwoVectors(Vec3::UnitZ(), normal);
+    return Pose(Vec3(pose.x, pose.y, h(0, 0)) + normal * rest_z, tilt * quatFromRPY(0, 0, pose.yaw));
+  };
   auto problemAt = [&](const Run& run, const std::string& which, const Pose2D& pose, double z) -> std::string {
-    robot->setBasePose(placedPose(world, pose, z, rest_z));
+    robot->setBasePose(run.kind == RunKind::Drive ? onTheSlope(pose) : placedPose(world, pose, z, rest_z));
     const World::Overlap o = world.deepestOverlap(*robot);
     if (o.depth <= World::kPlacementTolerance) return "";
     std::ostringstream why;

@@ -353,6 +353,15 @@ TEST(Dataset, PlacesNoRobotCanHaveBeenMeasuredAtAreNamed) {
   EXPECT_NE(inside.find("run 'straight', start pose (x 0.46 m"), std::string::npos) << inside;
   EXPECT_NE(inside.find("deep inside box 'wall'"), std::string::npos) << inside;
 
+  // A start on a 20 deg ramp stands on it.
+  const Dataset ramp = loadDataset(makeDataset(
+      "ramp", drive_csv,
+      "format: sbot-dataset/1\nname: ramp\nrobot: simple\nworld:\n  obstacles:\n"
+      "    - {name: ramp, center: [0, 0, 0], size: [1, 1, 0.1], yaw: 0, pitch: 0.35, surface: white_paper}\n"
+      "runs:\n  - {name: straight, file: straight.csv, kind: drive, initial_pose: {x: 0, y: 0, yaw: 0.5}}\n"));
+  EXPECT_EQ(impossiblePlacement(ramp, "simple"), "");
+  EXPECT_EQ(impossiblePlacement(ramp, "detailed"), "");
+
   const std::string d = makeDataset("placements", drive_csv,
                                     withRun("  - {name: held, file: held.csv, kind: place}\n"));
   write(d + "/held.csv", "x,y,yaw,z,ir0\n0.30,0,0,,100\n0.47,0,0,,100\n");
