@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -684,6 +685,7 @@ Dataset loadDatasetFields(const std::string& path_in) {
   const YAML::Node runs = root["runs"];
   if (!runs || !runs.IsSequence() || runs.size() == 0) fail(f, runs ? runs : root, "runs", "expected a non-empty list of runs");
   std::set<std::string> names;
+  std::map<std::string, std::string> run_of_file;  // the file as the system resolves it -> its run
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const std::string field = "runs[" + std::to_string(i) + "]";
     const YAML::Node r = runs[i];
@@ -734,6 +736,13 @@ Dataset loadDatasetFields(const std::string& path_in) {
              "must be at most " + fmtNumber(kMaxStartTime) + " s (a time in the session, not a date)");
     }
     run.path = run.file[0] == '/' ? run.file : ds.dir + "/" + run.file;
+    // One file, one run's measurements: a second run naming it (a copy-paste slip) replayed the
+    // first run's data from the second's start pose and counted it twice.
+    char resolved[PATH_MAX];
+    const std::string same = ::realpath(run.path.c_str(), resolved) ? std::string(resolved) : run.path;
+    if (const auto [at, fresh] = run_of_file.emplace(same, run.name); !fresh)
+      fail(f, r["file"], field + ".file", "'" + run.file + "' is already the file of run '" + at->second +
+                                              "': each run needs its own measurements");
     parseRunCsv(readFile(run.path, f, r["file"]), run.path, run);
     ds.runs.push_back(std::move(run));
   }

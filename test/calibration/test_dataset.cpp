@@ -319,6 +319,13 @@ TEST(Dataset, RunNamesStartPosesAndSegmentsAreChecked) {
   e = errorOf(makeDataset("type", csv, withRun("  - {name: s, group: [a, b], file: straight.csv, initial_pose: {x: 0, y: 0, yaw: 0}}\n")));
   EXPECT_NE(e.file().find("dataset.yaml"), std::string::npos) << e.what();
   EXPECT_EQ(e.line(), 8) << e.what();
+  // Two runs naming one file (a copy-paste slip) replayed the first run's data from the second's
+  // start pose; also when the second names it another way.
+  e = errorOf(makeDataset("same_file", csv,
+                          withRun("  - {name: a, file: straight.csv, initial_pose: {x: 0, y: 0, yaw: 0}}\n"
+                                  "  - {name: b, file: ./straight.csv, initial_pose: {x: 1, y: 0, yaw: 0}}\n")));
+  EXPECT_NE(std::string(e.what()).find("runs[1].file': './straight.csv' is already the file of run 'a'"), std::string::npos)
+      << e.what();
   // Re-anchoring every 50 ms hid a 10 % speed error.
   e = errorOf(makeDataset("segment", csv, "align_segment: 0.05\n" + std::string(kYaml)));
   EXPECT_NE(std::string(e.what()).find("at least 1 s"), std::string::npos) << e.what();
