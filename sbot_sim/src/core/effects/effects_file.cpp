@@ -162,17 +162,17 @@ std::string effectsToYaml(const std::vector<EffectConfig>& configs, const std::s
     return o.str();
   }
   o << "effects:\n";
-  // digits 0: the shortest text that reads back as the same double.
-  auto map = [&o](const std::map<std::string, double>& m, int digits) {
-    o << std::setprecision(digits) << "{";
+  // exact: the shortest text that reads back as the same double; otherwise 8 significant digits.
+  auto map = [&o](const std::map<std::string, double>& m, bool exact) {
+    o << std::setprecision(8) << "{";
     bool first = true;
     for (const auto& [k, v] : m) {
       o << (first ? "" : ", ") << k << ": ";
-      if (digits > 0) {
-        o << v;
-      } else {
+      if (exact) {
         char text[32];
         o << std::string_view(text, std::to_chars(text, text + sizeof text, v).ptr - text);
+      } else {
+        o << v;
       }
       first = false;
     }
@@ -182,11 +182,11 @@ std::string effectsToYaml(const std::vector<EffectConfig>& configs, const std::s
     o << "  - name: " << c.name << "\n    params: ";
     // Every digit: a replay is chaotic enough that the 8 digits written before moved a fitted
     // Simple's error by 0.3 % (2.3969 in the fit, 2.4041 in compare of its file).
-    map(c.params, 0);
+    map(c.params, true);
     o << "\n";
     if (!c.stderr_.empty()) {
       o << "    stderr: ";
-      map(c.stderr_, 8);
+      map(c.stderr_, false);
       o << "\n";
     }
     if (!c.note.empty()) o << "    note: " << YAML::Node(c.note) << "\n";
