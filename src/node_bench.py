@@ -8,7 +8,10 @@ For each robot count it starts its own ROS master on a free port, runs simulator
 config/scenarios/bench_flat.yaml for `seconds` of simulated time while `rosbag record` subscribes
 to every topic but the raw camera images (so every sensor is computed and every message serialised
 and sent), and prints the real-time multiplier
-(simulated s / wall s), wall time per step and the node's peak resident memory.
+(simulated s / wall s), wall time per step and the node's peak resident memory. The node starts
+paused and runs once the recorder has subscribed to every topic it publishes (with 100 robots that
+takes seconds, a one-off cost a long recording does not pay again): the row times recording in its
+steady state, and its last column says how long the subscribing took.
 
 --chains K (issue "Scale", seed 2.3): the robots stand in chains of K linked by static front-gripper
 links (scenario `links:`), headless and unrecorded; a driver node sends every chain one random
@@ -128,6 +131,53 @@ def drive_chains(robots, k, stats_path):
         json.dump(stats, f)
 
 
+def gate_on_recorder(exclude, stats_path):
+    """The recorder's gate (a child process): the node starts paused; step it once (`rosbag record`
+    waits for a non-zero sim clock before it subscribes), wait until the recorder has registered a
+    subscription to every topic the simulator publishes but the excluded ones, then unpause. Writes
+    the topic count and the seconds the subscribing took to `stats_path`."""
+    import rospy
+    from sbot_msgs.srv import Step
+    from std_srvs.srv import Trigger
+    rospy.init_node('node_bench_gate', anonymous=True, disable_signals=True)
+    rospy.wait_for_service('/sim/step')
+    start = time.time()
+    try:
+        topics, missing = wait_recorder_subscribed(rospy.get_name(), exclude, Step, start + 120)
+    finally:  # whatever happened, the paused node must run (and end), or the benchmark hangs
+        connected = time.time() - start
+        time.sleep(1.0)  # registration precedes the TCP connection: let the last ones connect
+        rospy.ServiceProxy('/sim/unpause', Trigger)()
+    with open(stats_path, 'w') as f:
+        json.dump({'topics': topics, 'missing': len(missing), 'connect_s': connected}, f)
+
+
+def wait_recorder_subscribed(caller, exclude, step_srv, deadline):
+    """Steps the paused node until the recorder starts, and polls the master until it subscribes to
+    every topic the simulator publishes but the excluded ones (or the deadline). Returns the number
+    of such topics and the list of those still missing."""
+    import rosgraph
+    import rospy
+    step = rospy.ServiceProxy('/sim/step', step_srv)
+    master = rosgraph.Master(caller)
+    excluded = re.compile(exclude)
+    topics, missing = 0, []
+    while time.time() < deadline:
+        publishers, subscribers, _ = master.getSystemState()
+        subscribed = {topic: nodes for topic, nodes in subscribers}
+        ours = [t for t, nodes in publishers if '/simulator' in nodes and not excluded.fullmatch(t)]
+        missing = [t for t in ours if not any(n.startswith('/record') for n in subscribed.get(t, []))]
+        topics = len(ours)
+        if ours and not missing:
+            break
+        if set(ours) - set(missing) <= {'/clock'}:
+            # The recorder has not started: it waits for a clock message, which it may have missed
+            # (one per step, and it connects when it connects). A step per poll until it starts.
+            step(1)
+        time.sleep(0.2)
+    return topics, missing
+
+
 def run(robots, seconds, scenario, chains=0):
     port = free_port()
     env = dict(os.environ, ROS_MASTER_URI='http://127.0.0.1:%d' % port)
@@ -152,23 +202,31 @@ def run(robots, seconds, scenario, chains=0):
             listener = subprocess.Popen(['rosbag', 'record', '-a', '-x', exclude, '-q',
                                          '-O', os.path.join(tmp, 'b.bag')],
                                         env=env, stdout=devnull, stderr=devnull, start_new_session=True)
+            stats_path = os.path.join(tmp, 'gate.json')
+            gate = subprocess.Popen([sys.executable, os.path.realpath(__file__), '--_gate', stats_path,
+                                     '--_exclude', exclude], env=env, stdout=devnull, stderr=devnull)
         time.sleep(1.0)
         log_path = os.path.join(tmp, 'node.log')
         with open(log_path, 'w') as log:
             node = subprocess.Popen(['rosrun', 'sbot_sim', 'simulator_node', '_scenario:=' + scenario,
                                      '_robots:=%d' % robots, '_duration:=%g' % seconds, '_real_time_factor:=0',
-                                     '_paused:=%s' % ('true' if chains else 'false')],  # the driver unpauses
+                                     '_paused:=true'],  # the driver or the recorder's gate unpauses
                                     env=env, stdout=log, stderr=subprocess.STDOUT)
             peak = 0.0
             while node.poll() is None:
                 peak = max(peak, peak_rss_mib(node.pid))
+                if not chains and gate.poll() not in (None, 0):  # no gate, no unpause: stop the paused node
+                    node.terminate()
                 time.sleep(0.05)
         # The listener (`rosbag record`, whose recorder is a child process, or the chain driver):
         # interrupt the whole group (SIGINT closes the bag; the driver writes its counts), or a child
         # outlives the benchmark and loads the next rows.
         os.killpg(listener.pid, signal.SIGINT)
         listener.wait()
-        if chains and os.path.exists(stats_path):
+        if not chains and gate.poll() is None:  # the node ended before the gate unpaused it
+            gate.kill()
+            gate.wait()
+        if os.path.exists(stats_path):
             with open(stats_path) as f:
                 stats = json.load(f)
         # The node's own summary times the stepping loop (start-up and spawning excluded).
@@ -213,9 +271,14 @@ def main():
     parser.add_argument('--seconds', type=positive_seconds, default=20.0)
     parser.add_argument('--chains', type=positive_int, default=0, help='robots per chain (static front-gripper links)')
     parser.add_argument('--_driver', help=argparse.SUPPRESS)
+    parser.add_argument('--_gate', help=argparse.SUPPRESS)
+    parser.add_argument('--_exclude', help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args._driver:
         drive_chains(args.robots[0], args.chains, args._driver)
+        return 0
+    if args._gate:
+        gate_on_recorder(args._exclude, args._gate)
         return 0
     counts = args.robots or ([100] if args.chains else [1, 10, 100])
     scenario = os.path.join(rospkg.RosPack().get_path('swarmbot3d'), 'config', 'scenarios', 'bench_flat.yaml')
@@ -223,7 +286,8 @@ def main():
         print('node_bench: simulator_node, chains of %d (static front-gripper links), one random command per chain '
               'and second, /swarm/graph at 10 Hz, nothing recorded' % args.chains)
     else:
-        print('node_bench: simulator_node + rosbag record -a (raw camera images excluded), flat arena, idle robots')
+        print('node_bench: simulator_node + rosbag record -a (raw camera images excluded), flat arena, idle robots; '
+              'timed from the recorder subscribed to every topic')
     print('%-8s %7s %10s %12s %14s %12s' % ('level', 'robots', 'sim_s', 'RTM', 'wall_ms/step', 'peak_MiB'))
     failures = 0
     for n in counts:
@@ -243,6 +307,11 @@ def main():
             else:
                 failures += 1
                 line += '   /swarm/graph: no messages received'
+        elif stats and stats['missing'] == 0:
+            line += '   recorder subscribed to %d topics in %.1f s' % (stats['topics'], stats['connect_s'])
+        else:
+            failures += 1
+            line += '   the recorder missed %s of the topics' % (stats['missing'] if stats else 'all')
         print(line)
         sys.stdout.flush()
     return 1 if failures else 0

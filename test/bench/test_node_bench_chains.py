@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """node_bench.py --chains: the simulator node runs robots linked in chains by static front-gripper
 links, the driver moves them, and /swarm/graph reports the chains as swarm-bots at 10 Hz of simulated
-time. Checks what the benchmark line says, not how fast it was (no timing bar in a test)."""
+time. node_bench.py (recording): the node is timed only once `rosbag record -a` has subscribed to
+every topic. Checks what the benchmark line says, not how fast it was (no timing bar in a test)."""
 import os
 import re
 import subprocess
@@ -30,6 +31,18 @@ class NodeBenchChains(unittest.TestCase):
         self.assertAlmostEqual(hz, 10.0, delta=0.5)
         self.assertEqual(components, 2)            # two chains of five, each one swarm-bot
         self.assertGreater(moved, 0.01)            # the driver's commands reached the robots
+
+    def test_recording_is_timed_once_the_recorder_has_every_topic(self):
+        r = bench("--robots", "2", "--seconds", "2")
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        line = [l for l in r.stdout.splitlines() if l.startswith("simple")]
+        self.assertEqual(len(line), 1, r.stdout)
+        m = re.search(r"simple\s+2\s+2\.0\s+([0-9.]+) .*recorder subscribed to (\d+) topics in ([0-9.]+) s", line[0])
+        self.assertIsNotNone(m, line[0])
+        self.assertGreater(float(m.group(1)), 0)
+        # Two robots' sensor, state and TF topics (about 24 each, per-IR Range topics included), /clock,
+        # /tf and the swarm's: fewer means the gate counted before the node had advertised.
+        self.assertGreater(int(m.group(2)), 2 * 20)
 
     def test_bad_options_are_refused_by_name(self):
         for option, bad in (("--chains", "0"), ("--chains", "x"), ("--seconds", "-1"), ("--seconds", "nan"),
