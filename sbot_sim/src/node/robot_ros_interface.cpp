@@ -36,7 +36,8 @@ RobotRosInterface::RobotRosInterface(ros::NodeHandle nh, sbot::Robot& robot, boo
   // Deep queues: as fast as possible, the simulator outpaces subscribers such as rosbag in bursts.
   ground_truth_pub_ = nh_.advertise<nav_msgs::Odometry>("ground_truth", kStateQueue, ground_truth_subs_.connected(),
                                                          ground_truth_subs_.disconnected());
-  joint_states_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", kStateQueue);
+  joint_states_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", kStateQueue, joint_states_subs_.connected(),
+                                                              joint_states_subs_.disconnected());
   track_state_pub_ = nh_.advertise<sbot_msgs::TrackState>("track_state", kStateQueue, track_state_subs_.connected(),
                                                           track_state_subs_.disconnected());
   turret_state_pub_ = nh_.advertise<sbot_msgs::TurretState>("turret/state", kStateQueue, turret_state_subs_.connected(),
@@ -161,8 +162,10 @@ void RobotRosInterface::publishState(const ros::Time& stamp,
   const sbot::Robot& r = *robot_;
   const sbot::Pose base = r.basePose();
 
+  // Each state is built and sent only while subscribed (the rosters, not Publisher::getNumSubscribers,
+  // whose look-up among all the node's publications cost 11 % of a 100-robot node's CPU, every step).
   // Ground truth: pose in `world`, twist of the base_link origin in base_link (REP 105).
-  if (ground_truth_pub_.getNumSubscribers() > 0) {
+  if (ground_truth_subs_.any()) {
     nav_msgs::Odometry odom;
     odom.header.stamp = stamp;
     odom.header.frame_id = "world";
@@ -181,7 +184,7 @@ void RobotRosInterface::publishState(const ros::Time& stamp,
     publishNoted(ground_truth_pub_, name_, "ground_truth", odom);
   }
 
-  if (joint_states_pub_.getNumSubscribers() > 0) {
+  if (joint_states_subs_.any()) {
     sensor_msgs::JointState js;
     js.header.stamp = stamp;
     for (const sbot::JointState& s : r.jointStates()) {
@@ -193,7 +196,7 @@ void RobotRosInterface::publishState(const ros::Time& stamp,
     joint_states_pub_.publish(js);
   }
 
-  if (track_state_pub_.getNumSubscribers() > 0) {
+  if (track_state_subs_.any()) {
     sbot_msgs::TrackState ts;
     ts.header.stamp = stamp;
     ts.header.frame_id = base_frame_;
@@ -210,7 +213,7 @@ void RobotRosInterface::publishState(const ros::Time& stamp,
     publishNoted(track_state_pub_, name_, "track_state", ts);
   }
 
-  if (turret_state_pub_.getNumSubscribers() > 0 && !r.description().turret.joint.empty()) {
+  if (turret_state_subs_.any() && !r.description().turret.joint.empty()) {
     sbot_msgs::TurretState tu;
     tu.header.stamp = stamp;
     tu.header.frame_id = base_frame_;

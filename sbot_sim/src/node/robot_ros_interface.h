@@ -72,9 +72,9 @@ class RobotRosInterface {
   bool set_description_params_ = false;
 
   ros::Subscriber cmd_speed_sub_, cmd_vel_sub_;
-  /// Who subscribes to the three topics controllers read (the lock-step gate asks). Declared before
-  /// the publishers whose callbacks fill them, so they outlive them.
-  SubscriberRoster ground_truth_subs_, track_state_subs_, turret_state_subs_;
+  /// Who subscribes to the state topics (publishState asks; for the three controllers read, the
+  /// lock-step gate too). Declared before the publishers whose callbacks fill them, so they outlive them.
+  SubscriberRoster ground_truth_subs_, joint_states_subs_, track_state_subs_, turret_state_subs_;
   ros::Publisher ground_truth_pub_, joint_states_pub_, track_state_pub_, turret_state_pub_;
   ros::Publisher model_level_pub_;
   ros::ServiceServer set_turret_srv_;
