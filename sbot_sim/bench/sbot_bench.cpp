@@ -1,7 +1,7 @@
 // sbot_bench: how fast the headless core simulates swarms. Not a test: it prints figures.
 //
-//   sbot_bench [--level simple] [--robots 1,10,100] [--seconds 20] [--step 0.01] [--chains K] [--idle] [--profile]
-//   sbot_bench --scenario FILE [--robots N,...] [--seconds 20] [--idle] [--profile]
+//   sbot_bench [--level simple] [--robots 1,10,100] [--seconds 20] [--step 0.01] [--chains K] [--idle] [--sensors] [--profile]
+//   sbot_bench --scenario FILE [--robots N,...] [--seconds 20] [--idle] [--sensors] [--profile]
 //
 // --chains K: the robots form chains of K connected by static front-gripper links (robot i+1 grips
 // robot i; core/swarm/swarm_graph.h), each chain driving one random-walk command, and the swarm graph
@@ -13,6 +13,11 @@
 // --idle: the robots stand (setSpeed(0, 0)) instead of walking. They get 3 simulated seconds,
 // untimed, to settle and fall asleep (sleeping at rest, on unless the scenario's world turns it
 // off); then --seconds are timed, and the row says how many are asleep at the end.
+// --sensors: every robot's LED ring lit (red) and, at the simulator node's default 10 Hz, every
+// robot's sensors read as a controller subscribed to all of them would: the proximity ring, ground
+// and light sensors where its level has them, and the fake camera's blobs (each lit LED group of
+// another robot in range costs an occlusion ray, so this part grows with the square of the robots).
+// The row says how many blobs a camera saw on average; --profile gives the sensors' share.
 // --profile: also print where the step time goes (World::enableProfile): solver, collision
 // detection, motor commands, feedback, and the contact joints per step.
 //
@@ -36,6 +41,8 @@
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/scenario.h"  // kMaxRobots
 #include "sbot_sim/core/scenario_world.h"
+#include "sbot_sim/core/sensors/environment.h"
+#include "sbot_sim/core/sensors/sensor_suite.h"
 #include "sbot_sim/core/swarm/swarm_graph.h"
 #include "sbot_sim/core/world.h"
 #include "sbot_sim/tools/cli_args.h"
@@ -50,13 +57,15 @@ struct Options {
   int chains = 0;   // robots per chain, 0 = unconnected
   bool profile = false;
   bool idle = false;  // stand instead of the random walk (after an untimed settling)
+  bool sensors = false;  // lit LEDs, every robot's sensors and fake camera read at 10 Hz
   std::string scenario;  // a scenario file instead of the arena ("": the arena)
   bool robots_given = false;
 };
 
 constexpr const char* kUsage =
-    "usage: sbot_bench [--level L] [--robots 1,10,100] [--seconds S] [--step DT] [--chains K] [--idle] [--profile]\n"
-    "       sbot_bench --scenario FILE [--robots N,...] [--seconds S] [--idle] [--profile]\n";
+    "usage: sbot_bench [--level L] [--robots 1,10,100] [--seconds S] [--step DT] [--chains K] [--idle] [--sensors] "
+    "[--profile]\n"
+    "       sbot_bench --scenario FILE [--robots N,...] [--seconds S] [--idle] [--sensors] [--profile]\n";
 
 Options parse(int argc, char** argv) {
   // Values are checked (atoi/atof turned "--robots 0" or "--seconds -1" into a row of nonsense).
@@ -73,6 +82,7 @@ Options parse(int argc, char** argv) {
     else if (a == "--chains") o.chains = args.count(0, sbot::kMaxRobots);
     else if (a == "--profile") o.profile = true;
     else if (a == "--idle") o.idle = true;
+    else if (a == "--sensors") o.sensors = true;
     else if (a == "--robots") {
       o.robots_given = true;
       o.robots.clear();
@@ -150,6 +160,39 @@ double cpuSeconds() {
   return ru.ru_utime.tv_sec + 1e-6 * ru.ru_utime.tv_usec + ru.ru_stime.tv_sec + 1e-6 * ru.ru_stime.tv_usec;
 }
 
+volatile unsigned g_sensor_sink = 0;
+
+/// --sensors: every robot's suite over one Environment, its LED ring lit so the cameras see it.
+class SwarmSensors {
+ public:
+  explicit SwarmSensors(sbot::World& w) : env_(w) {
+    for (sbot::Robot* r : w.robots()) {
+      env_.setSameLightColor(r->name(), sbot::sensors::kLedMaxUnits, 0, 0, 0);
+      suites_.push_back(std::make_unique<sbot::sensors::SensorSuite>(w, *r, env_));
+    }
+  }
+  /// Every robot reads what its level has, as a controller subscribed to all its sensors does.
+  void readAll(double dt) {
+    using sbot::sensors::SensorChannel;
+    for (auto& s : suites_) {
+      s->update(dt);
+      for (unsigned v : s->getAllProximitySensors()) sink_ += v;
+      if (s->available(SensorChannel::Ground)) for (unsigned v : s->getAllGroundSensors()) sink_ += v;
+      if (s->available(SensorChannel::Light)) for (unsigned v : s->getAllLightSensors()) sink_ += v;
+      blobs_ += s->getFakeCameraBlobs().size();
+      ++reads_;
+    }
+  }
+  double blobsPerRead() const { return reads_ ? static_cast<double>(blobs_) / static_cast<double>(reads_) : 0; }
+  unsigned sink() const { return sink_; }
+
+ private:
+  sbot::sensors::Environment env_;
+  std::vector<std::unique_ptr<sbot::sensors::SensorSuite>> suites_;
+  unsigned sink_ = 0;
+  std::size_t blobs_ = 0, reads_ = 0;
+};
+
 /// One row: `n` robots (--scenario: its swarm.count overridden, or its own robots for n < 0) on a
 /// random walk (or standing, --idle) for --seconds, in this process.
 void runOne(const Options& o, int n) {
@@ -166,6 +209,9 @@ void runOne(const Options& o, int n) {
   const int change_every = static_cast<int>(1.0 / c.step);  // new random command every simulated second
   constexpr double kIdleSettle = 3.0;  // [s] standing robots are all asleep well within it (core_test_rest)
   if (o.idle) w.stepN(static_cast<int>(kIdleSettle / c.step));
+  std::unique_ptr<SwarmSensors> sensors = o.sensors ? std::make_unique<SwarmSensors>(w) : nullptr;
+  const int read_every = std::max(1, static_cast<int>(std::lround(0.1 / c.step)));  // 10 Hz, the node's default
+  double sensing_s = 0;
   w.enableProfile(o.profile);
   const double cpu0 = cpuSeconds();  // the settling (--idle) is not timed
   const auto t0 = std::chrono::steady_clock::now();
@@ -183,6 +229,11 @@ void runOne(const Options& o, int n) {
     }
     w.step();
     if (graph && s % graph_every == 0) components = sbot::swarm::computeSwarmGraph(w).components;
+    if (sensors && s % read_every == 0) {
+      const auto r0 = std::chrono::steady_clock::now();
+      sensors->readAll(read_every * c.step);
+      sensing_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+    }
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   rusage ru{};
@@ -195,6 +246,10 @@ void runOne(const Options& o, int n) {
     for (const sbot::Robot* r : w.robots()) asleep += r->asleep();
     std::printf("   idle, %d asleep at the end (after %.0f s untimed to settle)", asleep, kIdleSettle);
   }
+  if (sensors) {
+    std::printf("   sensors and fake camera read at 10 Hz, LEDs lit, %.1f blobs per camera read", sensors->blobsPerRead());
+    g_sensor_sink = sensors->sink();  // keeps the reads from being optimised away
+  }
   if (o.chains > 0) {
     // CPU-time RTM too: on a shared machine the wall clock includes waiting for a core.
     const double cpu = cpuSeconds() - cpu0;
@@ -205,6 +260,7 @@ void runOne(const Options& o, int n) {
     std::printf("   solver %.0f %%, collision %.0f %%, commands %.0f %%, feedback %.0f %%, %.1f contacts/step",
                 100 * p.solver_s / wall, 100 * p.collision_s / wall, 100 * p.commands_s / wall,
                 100 * p.feedback_s / wall, static_cast<double>(p.contacts) / static_cast<double>(p.steps));
+    if (sensors) std::printf(", sensors %.0f %%", 100 * sensing_s / wall);
   }
   std::printf("\n");
   std::fflush(stdout);
@@ -216,7 +272,8 @@ int main(int argc, char** argv) {
   const Options o = parse(argc, argv);
   if (o.scenario.empty()) {
     sbot_tools::requireLevel("sbot_bench", "--level", o.level);
-    std::printf("sbot_bench: headless core, flat arena, %s, 1 core per run\n", o.idle ? "idle" : "random walk");
+    std::printf("sbot_bench: headless core, flat arena, %s%s, 1 core per run\n", o.idle ? "idle" : "random walk",
+                o.sensors ? ", sensors" : "");
   } else {
     // Read here, before any row, so that a malformed file (or a count it cannot take) is refused once.
     try {

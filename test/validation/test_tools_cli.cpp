@@ -126,6 +126,23 @@ TEST(ToolsCli, BenchIdleRowsTimeStandingRobots) {
   EXPECT_NE(awake.output.find("idle, 0 asleep at the end"), std::string::npos) << awake.output;
 }
 
+// --sensors: every robot's LEDs lit and its sensors and fake camera read at 10 Hz; robots on the
+// arena's 0.3 m grid see each other's LEDs, a lone robot sees none.
+TEST(ToolsCli, BenchSensorRowsReadLitSwarms) {
+  const auto blobs = [](const std::string& output) {
+    const std::size_t at = output.find("LEDs lit, ");
+    return at == std::string::npos ? -1.0 : std::stod(output.substr(at + 10));
+  };
+  const Outcome four = sbot_test::runProcess(std::string(SBOT_BENCH_BIN) + " --sensors --profile --robots 4 --seconds 0.3");
+  ASSERT_EQ(four.status, 0) << four.output;
+  EXPECT_NE(four.output.find("random walk, sensors"), std::string::npos) << four.output;
+  EXPECT_GT(blobs(four.output), 3.0) << "three neighbours, 8 LED groups each, half facing: " << four.output;
+  EXPECT_NE(four.output.find("contacts/step, sensors "), std::string::npos) << "--profile gives their share: " << four.output;
+  const Outcome one = sbot_test::runProcess(std::string(SBOT_BENCH_BIN) + " --sensors --robots 1 --seconds 0.3");
+  ASSERT_EQ(one.status, 0) << one.output;
+  EXPECT_EQ(blobs(one.output), 0.0) << one.output;
+}
+
 // The last option without its value (two_sbots used to read it as "": --level "" then failed later
 // with an unrelated message).
 TEST(ToolsCli, AnOptionWithoutItsValueIsRefusedByName) {
