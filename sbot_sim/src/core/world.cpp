@@ -925,6 +925,135 @@ std::vector<RayHit> World::castRayBundles(const std::vector<Vec3>& origins, cons
   return hits;
 }
 
+namespace {
+
+/// Whether the segment from `origin` along unit `d`, `length` long, crosses `aabb` (ODE's layout;
+/// the slab test). Unlike segmentMayMeet's box against box, a long diagonal segment misses most of
+/// the boxes its own box covers.
+bool segmentCrosses(const Vec3& origin, const Vec3& d, double length, const dReal* aabb) {
+  constexpr double kSlack = 1e-9;  // [m] a ray grazing a box's face is tested, as ODE would
+  double t0 = 0, t1 = length;
+  for (int k = 0; k < 3; ++k) {
+    const double lo = aabb[2 * k] - kSlack, hi = aabb[2 * k + 1] + kSlack;
+    if (std::abs(d[k]) < 1e-12) {
+      if (origin[k] < lo || origin[k] > hi) return false;
+      continue;
+    }
+    double ta = (lo - origin[k]) / d[k], tb = (hi - origin[k]) / d[k];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+/// castRaysOfLengths' groups filed by the bearing sectors (of kSectors about the origin) their
+/// boxes cover; `of[k]` lists the groups a ray of bearing sector k may cross, in group order.
+struct SectorIndex {
+  static constexpr int kSectors = 64;
+  std::vector<std::vector<std::size_t>> of;
+  std::vector<std::size_t> all;  ///< every group (for rays with no bearing)
+  int sectorOf(const Vec3& d) const { return sectorOfBearing(std::atan2(d.y(), d.x())); }
+  static int sectorOfBearing(double bearing) {
+    const int k = static_cast<int>(std::floor((bearing + M_PI) / (2 * M_PI) * kSectors));
+    return ((k % kSectors) + kSectors) % kSectors;
+  }
+};
+
+template <class Group>
+SectorIndex fileBySector(const Vec3& origin, const std::vector<Group>& groups) {
+  constexpr double kMargin = 1e-6;  // [rad] bearings at a sector's edge are filed on both sides
+  SectorIndex index;
+  index.of.resize(SectorIndex::kSectors);
+  for (std::size_t gi = 0; gi < groups.size(); ++gi) {
+    index.all.push_back(gi);
+    const dReal* b = groups[gi].aabb;
+    const bool around = origin.x() >= b[0] && origin.x() <= b[1] && origin.y() >= b[2] && origin.y() <= b[3];
+    if (around || !std::isfinite(b[0] + b[1] + b[2] + b[3])) {  // seen from inside, or unbounded (a plane)
+      for (auto& sector : index.of) sector.push_back(gi);
+      continue;
+    }
+    // A box that does not hold the origin spans less than half a turn: its corners' bearings about
+    // the bearing of its centre give the interval.
+    const double centre = std::atan2(0.5 * (b[2] + b[3]) - origin.y(), 0.5 * (b[0] + b[1]) - origin.x());
+    double lo = 0, hi = 0;
+    for (int cx = 0; cx < 2; ++cx)
+      for (int cy = 2; cy < 4; ++cy) {
+        const double rel = std::remainder(std::atan2(b[cy] - origin.y(), b[cx] - origin.x()) - centre, 2 * M_PI);
+        lo = std::min(lo, rel);
+        hi = std::max(hi, rel);
+      }
+    const int first = SectorIndex::sectorOfBearing(centre + lo - kMargin);
+    const int span = SectorIndex::sectorOfBearing(centre + hi + kMargin) - first;
+    const int count = (span + SectorIndex::kSectors) % SectorIndex::kSectors + 1;
+    for (int k = 0; k < count; ++k) index.of[(first + k) % SectorIndex::kSectors].push_back(gi);
+  }
+  return index;
+}
+
+}  // namespace
+
+std::vector<RayHit> World::castRaysOfLengths(const Vec3& origin, const std::vector<Vec3>& directions,
+                                             const std::vector<double>& lengths, const Robot* ignore) const {
+  if (directions.size() != lengths.size())
+    throw std::invalid_argument("castRaysOfLengths: " + std::to_string(directions.size()) + " directions but " +
+                                std::to_string(lengths.size()) + " lengths");
+  std::vector<RayHit> hits(directions.size());
+  for (std::size_t i = 0; i < hits.size(); ++i) hits[i].distance = lengths[i];
+  if (directions.empty()) return hits;
+  const Vec3* units = unitDirections(directions);
+  Vec3 lo = origin, hi = origin;
+  for (std::size_t i = 0; i < directions.size(); ++i) growRayBounds(origin, units + i, 1, lengths[i], lo, hi);
+  findRayCandidates(lo, hi, ignore);
+  // Runs of one robot's geoms (the search descends into a robot's space and lists its geoms
+  // together), each with the box around them.
+  candidate_groups_.clear();
+  for (std::size_t i = 0; i < ray_candidates_.size(); ++i) {
+    const GeomInfo* gi = infoOf(ray_candidates_[i].geom);
+    const Robot* robot = gi ? gi->robot : nullptr;
+    const GeomInfo* prev = i > 0 ? infoOf(ray_candidates_[i - 1].geom) : nullptr;
+    const bool extends = i > 0 && robot && prev && prev->robot == robot;
+    if (!extends) {
+      CandidateGroup g{i, i, {}};
+      std::copy(ray_candidates_[i].aabb, ray_candidates_[i].aabb + 6, g.aabb);
+      candidate_groups_.push_back(g);
+    }
+    CandidateGroup& g = candidate_groups_.back();
+    g.end = i + 1;
+    for (int k = 0; k < 3; ++k) {
+      g.aabb[2 * k] = std::min(g.aabb[2 * k], ray_candidates_[i].aabb[2 * k]);
+      g.aabb[2 * k + 1] = std::max(g.aabb[2 * k + 1], ray_candidates_[i].aabb[2 * k + 1]);
+    }
+  }
+  // Every ray leaves the same origin, so a group's box can only be crossed by the rays whose
+  // bearing (azimuth about the origin) lies within the bearings of its corners: the groups are
+  // filed by bearing sector, and a ray tests its own sector's (and the groups seen from inside
+  // or from above, which every ray tests).
+  const SectorIndex sectors = fileBySector(origin, candidate_groups_);
+  for (std::size_t i = 0; i < directions.size(); ++i) {
+    const Vec3& d = units[i];
+    if (!(lengths[i] > 0)) continue;
+    dGeomID ray = nullptr;
+    RayQuery query{ignore, &hits[i]};
+    const bool steep = std::hypot(d.x(), d.y()) < 1e-9;  // no bearing: test every group
+    const std::vector<std::size_t>& filed = steep ? sectors.all : sectors.of[sectors.sectorOf(d)];
+    for (std::size_t gi : filed) {
+      const CandidateGroup& g = candidate_groups_[gi];
+      if (!segmentCrosses(origin, d, lengths[i], g.aabb)) continue;
+      for (std::size_t c = g.begin; c < g.end; ++c) {
+        if (g.end - g.begin > 1 && !segmentCrosses(origin, d, lengths[i], ray_candidates_[c].aabb)) continue;
+        if (!ray) {
+          ray = queryRay(lengths[i]);
+          dGeomRaySet(ray, origin.x(), origin.y(), origin.z(), d.x(), d.y(), d.z());
+        }
+        rayAgainstGeom(query, ray, ray_candidates_[c].geom);
+      }
+    }
+  }
+  return hits;
+}
+
 double World::terrainHeight(double x, double y) const {
   // Cast down against static geometry only: handles planes, tilted boxes and height fields alike.
   double best = config_.terrain.type == TerrainConfig::Type::Rough || !config_.terrain.ground_plane

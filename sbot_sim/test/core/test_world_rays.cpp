@@ -152,6 +152,64 @@ TEST(WorldRays, RaysEndingAtTheGroundPlaneAreCulledOnlyWhenTheyCannotReachIt) {
   EXPECT_FALSE(w.castRays(origin, {Vec3::UnitX()}, 0.2, nullptr)[0].hit);
 }
 
+// Lines of sight of their own lengths across a swarm (a fake camera's, castRaysOfLengths: a robot's
+// geoms tested only when the segment crosses the robot's box) see what castRay sees one by one,
+// among robots of every level, boxes and the ground, from the robots' camera height and grazing
+// the floor, with and without the looking robot ignored.
+TEST(WorldRays, LinesOfSightOfTheirOwnLengthsSeeWhatSingleRaysSee) {
+  WorldConfig c = flatWorld();
+  c.terrain.type = TerrainConfig::Type::Composite;
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < 6; ++i) {
+    BoxObstacle box;
+    box.name = "box_" + std::to_string(i);
+    box.center = Vec3(0.8 * u(rng), 0.8 * u(rng), 0.04);
+    box.size = Vec3(0.05, 0.1, 0.08);
+    box.yaw = M_PI * u(rng);
+    c.terrain.boxes.push_back(box);
+  }
+  World w(c);
+  const char* levels[] = {"simple", "medium", "detailed", "basic", "fast"};
+  std::vector<Robot*> robots;
+  for (int i = 0; i < 16; ++i)
+    robots.push_back(&w.addRobot(loadLevel(levels[i % 5]), {0.4 * (i % 4) - 0.6, 0.4 * (i / 4) - 0.6, 0.5 * i},
+                                 "sbot_" + std::to_string(i)));
+  runFor(w, 0.2);
+  int hits = 0, misses = 0;
+  for (int view = 0; view < 60; ++view) {
+    const Robot* looker = robots[view % robots.size()];
+    const Vec3 origin = looker->basePose().position + Vec3(0, 0, 0.05 + 0.05 * u(rng));
+    std::vector<Vec3> dirs;
+    std::vector<double> lengths;
+    for (const Robot* r : robots) {  // towards every robot's ring height, a little off its centre
+      const Vec3 target = r->basePose().position + Vec3(0.06 * u(rng), 0.06 * u(rng), 0.03 + 0.03 * u(rng));
+      if ((target - origin).norm() < 1e-3) continue;
+      dirs.push_back(target - origin);
+      lengths.push_back((target - origin).norm() - 0.003);
+    }
+    dirs.push_back(Vec3(1, 0.3, -0.2));  // down to the floor, and one of no length
+    lengths.push_back(2.0);
+    dirs.push_back(Vec3::UnitX());
+    lengths.push_back(0.0);
+    const Robot* ignore = view % 2 ? looker : nullptr;
+    const std::vector<RayHit> all = w.castRaysOfLengths(origin, dirs, lengths, ignore);
+    ASSERT_EQ(all.size(), dirs.size());
+    for (std::size_t i = 0; i < dirs.size(); ++i) {
+      const RayHit one = w.castRay(origin, dirs[i], lengths[i], ignore);
+      ASSERT_EQ(all[i].hit, one.hit) << "view " << view << " ray " << i;
+      EXPECT_DOUBLE_EQ(all[i].distance, one.distance);
+      EXPECT_EQ(all[i].robot, one.robot);
+      EXPECT_EQ(all[i].surface, one.surface);
+      (one.hit ? hits : misses) += 1;
+    }
+  }
+  EXPECT_GT(hits, 300) << "the lines of sight must be blocked often enough for the comparison to mean anything";
+  EXPECT_GT(misses, 100) << "and clear often enough";
+  EXPECT_THROW(w.castRaysOfLengths(Vec3::Zero(), {Vec3::UnitX()}, {0.1, 0.2}, nullptr), std::invalid_argument);
+  EXPECT_TRUE(w.castRaysOfLengths(Vec3::Zero(), {}, {}, nullptr).empty());
+}
+
 TEST(WorldRays, NothingInReachGivesMissesAtFullLength) {
   World w(flatWorld());
   const std::vector<RayHit> h = w.castRays(Vec3(0, 0, 0.5), {Vec3::UnitX(), Vec3(1, 1, 0)}, 0.2, nullptr);

@@ -97,6 +97,13 @@ class World {
   /// the spaces, for the box around all of them: the same hits as castRays per bundle.
   std::vector<RayHit> castRayBundles(const std::vector<Vec3>& origins, const std::vector<Vec3>& directions,
                                      double length, const Robot* ignore) const;
+  /// Rays from one origin, each with its own length (a camera's lines of sight to the LEDs it may
+  /// see): the same hits as castRay per (direction, length). One search of the spaces for the box
+  /// around all of them; then a ray is tested against a robot's geoms only if its segment crosses
+  /// that robot's bounding box, so that a long line of sight across a swarm does not test every
+  /// robot its axis-aligned box covers (as ODE's ray against a space does).
+  std::vector<RayHit> castRaysOfLengths(const Vec3& origin, const std::vector<Vec3>& directions,
+                                        const std::vector<double>& lengths, const Robot* ignore) const;
 
   /// The deepest overlap of `robot`'s geoms with the terrain or another robot as it stands now.
   struct Overlap {
@@ -190,6 +197,13 @@ class World {
   mutable dGeomID query_ray_ = nullptr;
   mutable dGeomID query_box_ = nullptr;  ///< castRays' bounding box, also in no space
   mutable std::vector<BoxedGeom> ray_candidates_;  ///< castRays' geoms within that box (reused)
+  /// castRaysOfLengths' runs of ray_candidates_ with one robot's geoms (a static geom alone), with
+  /// the box around each run (reused).
+  struct CandidateGroup {
+    std::size_t begin, end;
+    dReal aabb[6];
+  };
+  mutable std::vector<CandidateGroup> candidate_groups_;
   int solver_iterations_ = 0;
   Vec3 stepped_gravity_ = Vec3::Zero();  ///< [m/s^2] ODE's gravity at the last step (see step)
   bool exact_solver_ = false;     ///< config_.solver == "exact"

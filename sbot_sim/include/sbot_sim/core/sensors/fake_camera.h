@@ -14,8 +14,10 @@
 //     are not tested because the LED sits on its ring, so LEDs on the far side of a turret are
 //     hidden by it).
 // 360 deg horizontally. No noise (the seed gives none), no effects (nothing physical to modify).
-// Cost: one ray per candidate LED/lamp within range and elevation; LEDs whose ring faces away from
-// the camera are hidden by their own turret without a ray.
+// Cost: one line of sight per candidate LED/lamp within range and elevation, all tested together
+// (World::castRaysOfLengths: against a robot's geoms only where the line crosses its box), so a
+// lit swarm of N costs O(N^2) cheap box tests per frame; LEDs whose ring faces away from the
+// camera are hidden by their own turret without a ray.
 #pragma once
 
 #include <string>
