@@ -65,21 +65,28 @@ TEST(WorldRays, BundleSeesWhatSingleRaysSeeAmongBoxesAndRobots) {
   EXPECT_GT(hits, 1000) << "the bundles must actually hit things for the comparison to mean anything";
 }
 
-// Several bundles searched at once (a sensor ring, castRayBundles) see what each bundle sees alone.
-TEST(WorldRays, RingOfBundlesSeesWhatEachBundleSees) {
+/// A flat composite world with `n` upright boxes of `size` standing on the floor within +-`spread`
+/// m of the origin, each turned at random. Draws from `rng` (positions, then yaw, box by box).
+WorldConfig worldWithUprightBoxes(std::mt19937& rng, int n, double spread, const Vec3& size) {
   WorldConfig c = flatWorld();
   c.terrain.type = TerrainConfig::Type::Composite;
-  std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (int i = 0; i < 8; ++i) {
+  for (int i = 0; i < n; ++i) {
     BoxObstacle box;
     box.name = "box_" + std::to_string(i);
-    box.center = Vec3(0.3 * u(rng), 0.3 * u(rng), 0.05);
-    box.size = Vec3(0.05, 0.08, 0.1);
+    box.center = Vec3(spread * u(rng), spread * u(rng), size.z() / 2);
+    box.size = size;
     box.yaw = M_PI * u(rng);
     c.terrain.boxes.push_back(box);
   }
-  World w(c);
+  return c;
+}
+
+// Several bundles searched at once (a sensor ring, castRayBundles) see what each bundle sees alone.
+TEST(WorldRays, RingOfBundlesSeesWhatEachBundleSees) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  World w(worldWithUprightBoxes(rng, 8, 0.3, Vec3(0.05, 0.08, 0.1)));
   Robot& a = w.addRobot(loadLevel("medium"), {0, 0, 0}, "sbot_a");
   w.addRobot(loadLevel("simple"), {0.15, 0.05, 1.0}, "sbot_b");
   runFor(w, 0.2);
@@ -157,19 +164,9 @@ TEST(WorldRays, RaysEndingAtTheGroundPlaneAreCulledOnlyWhenTheyCannotReachIt) {
 // among robots of every level, boxes and the ground, from the robots' camera height and grazing
 // the floor, with and without the looking robot ignored.
 TEST(WorldRays, LinesOfSightOfTheirOwnLengthsSeeWhatSingleRaysSee) {
-  WorldConfig c = flatWorld();
-  c.terrain.type = TerrainConfig::Type::Composite;
   std::mt19937 rng(13);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (int i = 0; i < 6; ++i) {
-    BoxObstacle box;
-    box.name = "box_" + std::to_string(i);
-    box.center = Vec3(0.8 * u(rng), 0.8 * u(rng), 0.04);
-    box.size = Vec3(0.05, 0.1, 0.08);
-    box.yaw = M_PI * u(rng);
-    c.terrain.boxes.push_back(box);
-  }
-  World w(c);
+  World w(worldWithUprightBoxes(rng, 6, 0.8, Vec3(0.05, 0.1, 0.08)));
   const char* levels[] = {"simple", "medium", "detailed", "basic", "fast"};
   std::vector<Robot*> robots;
   for (int i = 0; i < 16; ++i)
