@@ -132,10 +132,10 @@ def drive_chains(robots, k, stats_path):
 
 
 def gate_on_recorder(exclude, stats_path):
-    """The recorder's gate (a child process): the node starts paused; step it once (`rosbag record`
-    waits for a non-zero sim clock before it subscribes), wait until the recorder has registered a
-    subscription to every topic the simulator publishes but the excluded ones, then unpause. Writes
-    the topic count and the seconds the subscribing took to `stats_path`."""
+    """The recorder's gate (a child process): the node starts paused; step it until the recorder
+    starts (`rosbag record` waits for a sim clock message before it subscribes), wait until it has
+    registered a subscription to every topic the simulator publishes but the excluded ones, then
+    unpause. Writes the topic count and the seconds the subscribing took to `stats_path`."""
     import rospy
     from sbot_msgs.srv import Step
     from std_srvs.srv import Trigger

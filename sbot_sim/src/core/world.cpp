@@ -1028,8 +1028,8 @@ std::vector<RayHit> World::castRaysOfLengths(const Vec3& origin, const std::vect
   }
   // Every ray leaves the same origin, so a group's box can only be crossed by the rays whose
   // bearing (azimuth about the origin) lies within the bearings of its corners: the groups are
-  // filed by bearing sector, and a ray tests its own sector's (and the groups seen from inside
-  // or from above, which every ray tests).
+  // filed by bearing sector, and a ray tests its own sector's (a group whose box holds the origin
+  // in plan, or has no bounds, such as a ground plane, is filed in every sector).
   const SectorIndex sectors = fileBySector(origin, candidate_groups_);
   for (std::size_t i = 0; i < directions.size(); ++i) {
     const Vec3& d = units[i];
