@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Benchmark the simulator node with its topics (the ROS counterpart of sbot_bench).
 
-    rosrun swarmbot3d node_bench.py [--robots 1,10,100] [--seconds 10]
+    rosrun swarmbot3d node_bench.py [--robots 1,10,100] [--seconds 10] [--compact]
     rosrun swarmbot3d node_bench.py --chains 5 [--robots 100] [--seconds 20]
 
 For each robot count it starts its own ROS master on a free port, runs simulator_node on
@@ -11,7 +11,8 @@ and sent), and prints the real-time multiplier
 (simulated s / wall s), wall time per step and the node's peak resident memory. The node starts
 paused and runs once the recorder has subscribed to every topic it publishes (with 100 robots that
 takes seconds, a one-off cost a long recording does not pay again): the row times recording in its
-steady state, and its last column says how long the subscribing took.
+steady state, and its last column says how long the subscribing took. --compact runs the node
+with ~per_sensor_topics false (the sensor arrays without the 23 per-sensor topics of each robot).
 
 --chains K (issue "Scale", seed 2.3): the robots stand in chains of K linked by static front-gripper
 links (scenario `links:`), headless and unrecorded; a driver node sends every chain one random
@@ -178,7 +179,7 @@ def wait_recorder_subscribed(caller, exclude, step_srv, deadline):
     return topics, missing
 
 
-def run(robots, seconds, scenario, chains=0):
+def run(robots, seconds, scenario, chains=0, per_sensor_topics=True):
     port = free_port()
     env = dict(os.environ, ROS_MASTER_URI='http://127.0.0.1:%d' % port)
     devnull = subprocess.DEVNULL
@@ -210,7 +211,8 @@ def run(robots, seconds, scenario, chains=0):
         with open(log_path, 'w') as log:
             node = subprocess.Popen(['rosrun', 'sbot_sim', 'simulator_node', '_scenario:=' + scenario,
                                      '_robots:=%d' % robots, '_duration:=%g' % seconds, '_real_time_factor:=0',
-                                     '_paused:=true'],  # the driver or the recorder's gate unpauses
+                                     '_paused:=true',  # the driver or the recorder's gate unpauses
+                                     '_per_sensor_topics:=%s' % ('true' if per_sensor_topics else 'false')],
                                     env=env, stdout=log, stderr=subprocess.STDOUT)
             peak = 0.0
             while node.poll() is None:
@@ -270,6 +272,8 @@ def main():
     parser.add_argument('--robots', type=robot_counts, default=None, help='robot counts (default 1,10,100; 100 with --chains)')
     parser.add_argument('--seconds', type=positive_seconds, default=20.0)
     parser.add_argument('--chains', type=positive_int, default=0, help='robots per chain (static front-gripper links)')
+    parser.add_argument('--compact', action='store_true',
+                        help='~per_sensor_topics false: no proximity/ir_<k> or light/sensor_<k> topics')
     parser.add_argument('--_driver', help=argparse.SUPPRESS)
     parser.add_argument('--_gate', help=argparse.SUPPRESS)
     parser.add_argument('--_exclude', help=argparse.SUPPRESS)
@@ -286,12 +290,12 @@ def main():
         print('node_bench: simulator_node, chains of %d (static front-gripper links), one random command per chain '
               'and second, /swarm/graph at 10 Hz, nothing recorded' % args.chains)
     else:
-        print('node_bench: simulator_node + rosbag record -a (raw camera images excluded), flat arena, idle robots; '
-              'timed from the recorder subscribed to every topic')
+        print('node_bench: simulator_node%s + rosbag record -a (raw camera images excluded), flat arena, idle robots; '
+              'timed from the recorder subscribed to every topic' % (' (~per_sensor_topics false)' if args.compact else ''))
     print('%-8s %7s %10s %12s %14s %12s' % ('level', 'robots', 'sim_s', 'RTM', 'wall_ms/step', 'peak_MiB'))
     failures = 0
     for n in counts:
-        code, wall, peak, stats = run(n, args.seconds, scenario, args.chains)
+        code, wall, peak, stats = run(n, args.seconds, scenario, args.chains, not args.compact)
         if code != 0:
             failures += 1
             print('%-8s %7d  simulator_node exited with %d' % ('simple', n, code))

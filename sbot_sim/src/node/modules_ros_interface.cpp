@@ -105,12 +105,18 @@ RobotModulesRos::RobotModulesRos(ros::NodeHandle nh, ros::NodeHandle pnh, const 
     SubscriberRoster& roster = subs_[key];
     return nh_.advertise<M>(topic, queue, roster.connected(), roster.disconnected(), ros::VoidConstPtr(), latch);
   };
+  // ~per_sensor_topics: false leaves out the 23 per-sensor topics, half of a robot's publications.
+  // roscpp looks a topic up linearly among all the node's publications at every publish, and a
+  // recorder's subscription costs a connection each, so a large swarm runs faster without them.
+  // Their rosters then never fill, so the per-sensor messages below are never built.
+  bool per_sensor_topics = true;
+  pnh_.param("per_sensor_topics", per_sensor_topics, true);
   pubs_["proximity"] = adv(Tag<sbot_msgs::ProximityArray>(), "proximity", "proximity", q, false);
-  for (int k = 0; k < sn::kProximitySensors; ++k)
+  for (int k = 0; per_sensor_topics && k < sn::kProximitySensors; ++k)
     ir_pubs_.push_back(adv(Tag<sensor_msgs::Range>(), "proximity/ir_" + std::to_string(k), "ir_" + std::to_string(k), q, false));
   pubs_["ground"] = adv(Tag<sbot_msgs::GroundArray>(), "ground", "ground", q, false);
   pubs_["light"] = adv(Tag<sbot_msgs::LightArray>(), "light", "light", q, false);
-  for (int k = 0; k < sn::kLightSensors; ++k)
+  for (int k = 0; per_sensor_topics && k < sn::kLightSensors; ++k)
     light_pubs_.push_back(adv(Tag<sensor_msgs::Illuminance>(), "light/sensor_" + std::to_string(k),
                               "light_" + std::to_string(k), q, false));
   pubs_["slope"] = adv(Tag<sbot_msgs::Slope>(), "slope", "slope", q, false);

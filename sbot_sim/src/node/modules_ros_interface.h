@@ -6,7 +6,8 @@
 // Per robot <r> (topics published at their own rate [Hz, sim time], param ~rates/<channel>,
 // changeable at run time through <r>/set_sampling_rate; a topic nobody subscribes to is not computed):
 //   proximity            sbot_msgs/ProximityArray   ~rates/proximity (10)
-//   proximity/ir_<k>     sensor_msgs/Range          same rate, k = 0..14, only while subscribed
+//   proximity/ir_<k>     sensor_msgs/Range          same rate, k = 0..14, only while subscribed;
+//                        not advertised with ~per_sensor_topics false (nor light/sensor_<k>)
 //   ground               sbot_msgs/GroundArray      ~rates/ground (10)     Medium, Detailed
 //   light                sbot_msgs/LightArray       ~rates/light (10)      Medium, Detailed
 //   slope                sbot_msgs/Slope            ~rates/slope (10)

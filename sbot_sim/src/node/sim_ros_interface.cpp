@@ -71,6 +71,7 @@ bool SimRosInterface::readParams() {
     int whole = 0;
     double number = 0;
     ok &= sbot_ros_params::readTypedParam(pnh_, "modules", flag);
+    ok &= sbot_ros_params::readTypedParam(pnh_, "per_sensor_topics", flag);
     ok &= sbot_ros_params::readTypedParam(pnh_, "marker_rate", number);
     ok &= sbot_ros_params::readTypedParam(pnh_, "trail_length", whole);
     ok &= sbot_ros_params::readTypedParam(pnh_, "graph_rate", number);
@@ -174,6 +175,10 @@ bool SimRosInterface::init() {
   }
   bool modules = true;  // ~modules: false = no sensor/actuator modules (benchmarking the bare node)
   pnh_.param("modules", modules, true);
+  bool per_sensor_topics = true;  // read by each robot's modules; echoed here once
+  pnh_.param("per_sensor_topics", per_sensor_topics, true);
+  ROS_INFO("simulator: ~modules=%s ~per_sensor_topics=%s", modules ? "true" : "false",
+           per_sensor_topics ? "true" : "false");
   if (modules) {
     modules_ = std::make_unique<ModulesRosInterface>(nh_, pnh_, world_, scenario_);
     modules_->attach();

@@ -127,6 +127,8 @@ class TestMalformedScenario(unittest.TestCase):
         self.assertRefused(self.run_node('_scenario:=' + path, '_robots:=abc'), '~robots must be a whole number', "'abc'")
         self.assertRefused(self.run_node('_scenario:=' + path, '_paused:=maybe'), '~paused must be true or false')
         self.assertRefused(self.run_node('_scenario:=' + path, '_rates/nosuch:=5'), '~rates/nosuch: unknown channel')
+        self.assertRefused(self.run_node('_scenario:=' + path, '_per_sensor_topics:=2'),
+                           '~per_sensor_topics must be true or false')
 
     def test_sidecar_value_the_sensors_cannot_use(self):
         description = rospkg.RosPack().get_path('sbot_description')
