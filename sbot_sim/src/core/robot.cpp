@@ -582,14 +582,18 @@ Pose Robot::linkPose(const std::string& link) const {
   return bodyPose(bodies_[it->second.body]) * it->second.body_T_link;
 }
 
-Pose Robot::linkPose(const LinkRef& link) const {
+bool Robot::resolve(const LinkRef& link) const {
   if (link.build_ != build_id_) {
     auto it = link_index_.find(link.name_);
-    if (it == link_index_.end()) throw UnknownName("robot " + name_ + " has no link '" + link.name_ + "'");
     link.build_ = build_id_;
-    link.body_ = it->second.body;
-    link.body_T_link_ = it->second.body_T_link;
+    link.body_ = it == link_index_.end() ? -1 : it->second.body;
+    if (it != link_index_.end()) link.body_T_link_ = it->second.body_T_link;
   }
+  return link.body_ >= 0;
+}
+
+Pose Robot::linkPose(const LinkRef& link) const {
+  if (!resolve(link)) throw UnknownName("robot " + name_ + " has no link '" + link.name_ + "'");
   return bodyPose(bodies_[link.body_]) * link.body_T_link_;
 }
 

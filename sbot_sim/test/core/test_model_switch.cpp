@@ -270,5 +270,21 @@ TEST(ModelSwitch, LinkRefsFollowTheRobotThroughRebuilds) {
   EXPECT_THROW(r.linkPose(LinkRef("no_such_link")), UnknownName);
 }
 
+TEST(ModelSwitch, ALinkRefKnowsALinkTheRobotLacksOnlyUntilARebuildAddsIt) {
+  World w(flatWorld());
+  Robot& r = w.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_0");
+  const LinkRef jaw("gripper_jaw_upper");  // the Detailed model's jaws; the Simple has none
+  EXPECT_FALSE(r.hasLink(jaw));
+  EXPECT_FALSE(r.hasLink(jaw)) << "asked again in the same build";
+  EXPECT_THROW(r.linkPose(jaw), UnknownName);
+  w.switchLevel("sbot_0", loadLevel("detailed"));
+  ASSERT_TRUE(r.hasLink(jaw)) << "the switch to detailed added the link";
+  const Pose by_ref = r.linkPose(jaw), by_name = r.linkPose(jaw.name());
+  EXPECT_LT((by_ref.position - by_name.position).norm(), 1e-12);
+  w.switchLevel("sbot_0", loadLevel("simple"));
+  EXPECT_FALSE(r.hasLink(jaw)) << "and the switch back removed it";
+  EXPECT_THROW(r.linkPose(jaw), UnknownName);
+}
+
 }  // namespace
 }  // namespace sbot

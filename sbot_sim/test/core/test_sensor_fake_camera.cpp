@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 
 #include "sbot_sim/core/sensors/fake_camera.h"
 #include "sim_fixture.h"
@@ -96,6 +97,33 @@ TEST(FakeCamera, RangeElevationOcclusionAndBlinking) {
   EXPECT_NEAR(blobs[0].elevation, M_PI / 4, 0.01);
   EXPECT_NEAR(blobs[0].distance, std::sqrt(2.0), 1e-6);
   EXPECT_EQ(blobs[0].colour, Vec3(1, 1, 0));
+}
+
+TEST(FakeCamera, AVerticalAngleFromAQuarterTurnOnSeesEveryElevation) {
+  World w(flatWorld());
+  RobotDescription wide = loadLevel("simple");
+  wide.extra["fake_camera_vertical_angle_rad"] = "2.0";  // beyond pi/2: no elevation limit
+  Robot& a = w.addRobot(loadLevel("simple"), {0, 0, 0}, "a");  // the seed's +-70 deg
+  Robot& b = w.addRobot(wide, {15, 0, 0}, "b");                 // out of a's 10 m range
+  Environment env(w);
+  for (const Robot* r : {&a, &b}) {  // lamps 0-2 about a, 3-5 about b, in its camera's frame
+    const Pose f = r->linkPose("fake_camera");
+    for (const Vec3& offset : {Vec3(0.5, 0, 0.4), Vec3(0.1, 0, 0.6), Vec3(0, 0, 0.8)})  // 39, 81, 90 deg up
+      env.addLamp(f.position + f.orientation * offset, 1000);
+  }
+  auto elevations = [](const FakeCamera& cam) {
+    std::map<int, double> out;
+    for (const Blob& bl : cam.blobs()) out[bl.index] = bl.elevation;
+    return out;
+  };
+  const auto seen_a = elevations(FakeCamera(w, a, env));
+  ASSERT_EQ(seen_a.size(), 1u) << "a sees only its 39 deg lamp";
+  EXPECT_NEAR(seen_a.at(0), std::atan2(0.4, 0.5), 1e-6);
+  const auto seen_b = elevations(FakeCamera(w, b, env));
+  ASSERT_EQ(seen_b.size(), 3u) << "b sees all three of its lamps";
+  EXPECT_NEAR(seen_b.at(3), std::atan2(0.4, 0.5), 1e-6);
+  EXPECT_NEAR(seen_b.at(4), std::atan2(0.6, 0.1), 1e-6);
+  EXPECT_NEAR(seen_b.at(5), M_PI / 2, 1e-6);
 }
 
 }  // namespace

@@ -117,6 +117,8 @@ class Robot {
   /// linkPose through a LinkRef: the same pose, the name looked up once per build of the robot.
   Pose linkPose(const LinkRef& link) const;
   bool hasLink(const std::string& link) const { return link_index_.count(link) != 0; }
+  /// hasLink through a LinkRef: its absence, like its frame, is looked up once per build.
+  bool hasLink(const LinkRef& link) const { return resolve(link); }
   Vec3 linearVelocity() const;   ///< of base_link's body, world frame [m/s]
   Vec3 angularVelocity() const;  ///< world frame [rad/s]
   std::vector<JointState> jointStates() const;
@@ -286,6 +288,8 @@ class Robot {
   /// Unique over the process and every build() of every robot: a LinkRef resolved in another
   /// build (of this robot, or of another) is looked up again.
   std::uint64_t build_id_ = 0;
+  /// Resolve `link` in this build if it was resolved in another; whether this robot has it.
+  bool resolve(const LinkRef& link) const;
   std::vector<int> left_hinges_, right_hinges_;
   int turret_hinge_ = -1;
   Pose base_body_T_base_;                ///< base_link in its body's (centre of mass) frame

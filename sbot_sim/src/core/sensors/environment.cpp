@@ -18,6 +18,12 @@ double blinkPeriod(unsigned code) {
   return periods[code];
 }
 
+std::array<LinkRef, kLedGroups> ledGroupFrames() {
+  std::array<LinkRef, kLedGroups> frames;
+  for (int g = 0; g < kLedGroups; ++g) frames[g] = LinkRef("light_" + std::to_string(g));
+  return frames;
+}
+
 bool LedRing::isLit(int group, double time) const {
   if (group < 0 || group >= kLedGroups) throw std::out_of_range("LED group must be in [0,7]");
   const LedGroup& g = groups[group];

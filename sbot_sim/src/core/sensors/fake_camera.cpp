@@ -22,10 +22,22 @@ FakeCamera::FakeCamera(World& world, Robot& robot, const Environment& env)
 std::vector<Blob> FakeCamera::blobs() const {
   const Pose cam = robot_.linkPose(link_);
   const Pose inv = cam.inverse();
-  const double turret = robot_.turretAngle();
   // The sources within range and elevation, then one occlusion test for all their lines of sight
-  // (World::castRaysOfLengths: the same answers as a castRay each, far cheaper across a swarm).
-  std::vector<Blob> seen;
+  // (World::castRaysOfLengths: the same answers as a castRay each, far cheaper across a swarm);
+  // only the visible ones are then made blobs (their angles and names), since in a swarm most
+  // candidates are hidden behind nearer robots.
+  struct Candidate {
+    Vec3 local;  ///< camera frame [m]
+    double distance;
+    Vec3 colour;
+    const std::string* source;
+    int index;
+  };
+  // |elevation| > vertical_angle, without the atan2: |z| > tan(vertical_angle) * hypot(x, y)
+  // (no limit from pi/2 on: every elevation is within it).
+  const bool limited = params_.vertical_angle < M_PI / 2;
+  const double tan_limit = limited ? std::tan(params_.vertical_angle) : 0.0;
+  std::vector<Candidate> candidates;
   std::vector<Vec3> sights;
   std::vector<double> lengths;
   auto consider = [&](const Vec3& p, const Vec3& colour, const std::string& source, int index, double clearance) {
@@ -33,17 +45,9 @@ std::vector<Blob> FakeCamera::blobs() const {
     const double d = v.norm();
     if (d > params_.range || d <= 0) return;
     const Vec3 local = inv.orientation * v;
-    const double elevation = std::atan2(local.z(), std::hypot(local.x(), local.y()));
-    if (std::abs(elevation) > params_.vertical_angle) return;
-    Blob b;
-    b.bearing_camera = std::atan2(local.y(), local.x());
-    b.bearing = wrapPi(b.bearing_camera + turret);
-    b.distance = d;
-    b.elevation = elevation;
-    b.colour = colour;
-    b.source = source;
-    b.index = index;
-    seen.push_back(b);
+    const double z2 = local.z() * local.z(), plan2 = local.x() * local.x() + local.y() * local.y();
+    if (limited && z2 > tan_limit * tan_limit * plan2) return;
+    candidates.push_back(Candidate{local, d, colour, &source, index});
     sights.push_back(v);
     lengths.push_back(d - clearance);  // <= 0: nothing between (castRaysOfLengths casts no ray)
   };
@@ -52,16 +56,29 @@ std::vector<Blob> FakeCamera::blobs() const {
     consider(led.position, Vec3(led.led->r, led.led->g, led.led->b) / static_cast<double>(kLedMaxUnits),
              led.robot->name(), led.group, params_.source_clearance);
   }
+  static const std::string kLamp = "lamp";
   if (params_.see_lamps) {
     const auto& lamps = env_.lamps();
     for (std::size_t i = 0; i < lamps.size(); ++i) {
-      if (lamps[i].intensity > 0) consider(lamps[i].position, lamps[i].colour, "lamp", static_cast<int>(i), 0.0);
+      if (lamps[i].intensity > 0) consider(lamps[i].position, lamps[i].colour, kLamp, static_cast<int>(i), 0.0);
     }
   }
   const std::vector<RayHit> hits = world_.castRaysOfLengths(cam.position, sights, lengths, &robot_);
+  const double turret = robot_.turretAngle();
   std::vector<Blob> out;
-  for (std::size_t i = 0; i < seen.size(); ++i)
-    if (!hits[i].hit) out.push_back(std::move(seen[i]));
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (hits[i].hit) continue;
+    const Candidate& c = candidates[i];
+    Blob b;
+    b.bearing_camera = std::atan2(c.local.y(), c.local.x());
+    b.bearing = wrapPi(b.bearing_camera + turret);
+    b.distance = c.distance;
+    b.elevation = std::atan2(c.local.z(), std::hypot(c.local.x(), c.local.y()));
+    b.colour = c.colour;
+    b.source = *c.source;
+    b.index = c.index;
+    out.push_back(std::move(b));
+  }
   std::sort(out.begin(), out.end(), [](const Blob& a, const Blob& b) { return a.distance < b.distance; });
   return out;
 }

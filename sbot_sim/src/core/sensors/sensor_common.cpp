@@ -125,15 +125,13 @@ std::vector<Vec3> coneRays(int rays, double half_angle, double first_azimuth) {
 std::vector<LedSource> litLeds(World& world, const Environment& env, const Robot* exclude) {
   std::vector<LedSource> out;
   const double now = world.time();
-  static const std::array<std::string, kLedGroups> links{"light_0", "light_1", "light_2", "light_3",
-                                                         "light_4", "light_5", "light_6", "light_7"};
   for (Robot* r : world.robots()) {
     if (r == exclude) continue;
     const LedRing& ring = env.ledRing(r->name());
     if (!ring.anyOn()) continue;
     for (int g = 0; g < kLedGroups; ++g) {
-      if (!ring.isLit(g, now) || !r->hasLink(links[g])) continue;
-      const Pose p = r->linkPose(links[g]);
+      if (!ring.isLit(g, now) || !r->hasLink(ring.frames[g])) continue;
+      const Pose p = r->linkPose(ring.frames[g]);
       out.push_back(LedSource{p.position, p.orientation * Vec3::UnitX(), &ring.groups[g], r, g});
     }
   }

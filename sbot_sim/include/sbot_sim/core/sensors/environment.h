@@ -24,6 +24,7 @@
 #include <utility>
 #include <vector>
 
+#include "sbot_sim/core/link_ref.h"
 #include "sbot_sim/core/types.h"
 
 namespace sbot {
@@ -64,9 +65,15 @@ struct LedGroup {
   bool on() const { return r + g + b > 0; }
 };
 
+/// The links light_0 .. light_7: where a ring's groups sit on its robot.
+std::array<LinkRef, kLedGroups> ledGroupFrames();
+
 /// The light ring of one robot.
 struct LedRing {
   std::array<LedGroup, kLedGroups> groups{};
+  /// Each group's link on the robot, looked up once per build of it (LinkRef): every camera and
+  /// light sensor of a lit swarm reads every other robot's ring.
+  std::array<LinkRef, kLedGroups> frames = ledGroupFrames();
   /// Whether `group` emits light at simulated `time` [s]: its colour is not black and, if it
   /// blinks, `time` falls in the first half of a blink period counted from when it was set (50 %
   /// duty cycle, lit first). The hardware maximum 10 Hz (BLINKING_RATE_10) is supported (the
