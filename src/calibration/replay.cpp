@@ -529,7 +529,7 @@ RunPrediction replayRun(const Dataset& ds, const Run& run, const ModelSpec& mode
   auto simulate = [&](const Pose2D& start) {
     ++g_replays;
     WorkerPool::count();
-      World world(wc);
+    World world(wc);
     if (opt.tilt != 0) {
       const double g = wc.gravity;
       dWorldSetGravity(world.odeWorld(), g * std::sin(opt.tilt) * std::cos(opt.tilt_direction),
