@@ -948,22 +948,34 @@ bool segmentCrosses(const Vec3& origin, const Vec3& d, double length, const dRea
   return true;
 }
 
-/// castRaysOfLengths' groups filed by the bearing sectors (of kSectors about the origin) their
-/// boxes cover; `of[k]` lists the groups a ray of bearing sector k may cross, in group order.
+/// A stand-in for atan2(dy, dx) that needs no trigonometry (the "diamond angle"), in (-2, 2]: 0
+/// along +x, +-1 along +-y, 2 along -x. It grows with the bearing, and turning half a turn adds 2,
+/// which is all the sectors below need (they are then up to 2x wider in angle at the diagonals).
+double diamondBearing(double dx, double dy) {
+  const double sum = std::abs(dx) + std::abs(dy);
+  if (sum == 0) return 0;
+  const double t = dy / sum;  // [-1, 1]
+  return dx >= 0 ? t : (dy >= 0 ? 2 - t : -2 - t);
+}
+
+/// castRaysOfLengths' groups filed by the bearing sectors (of kSectors about the origin, equal in
+/// diamondBearing) their boxes cover; `of[k]` lists the groups a ray of sector k may cross, in
+/// group order.
 struct SectorIndex {
   static constexpr int kSectors = 64;
+  static constexpr double kTurn = 4;  ///< a full turn in diamondBearing
   std::vector<std::vector<std::size_t>> of;
   std::vector<std::size_t> all;  ///< every group (for rays with no bearing)
-  int sectorOf(const Vec3& d) const { return sectorOfBearing(std::atan2(d.y(), d.x())); }
+  int sectorOf(const Vec3& d) const { return sectorOfBearing(diamondBearing(d.x(), d.y())); }
   static int sectorOfBearing(double bearing) {
-    const int k = static_cast<int>(std::floor((bearing + M_PI) / (2 * M_PI) * kSectors));
+    const int k = static_cast<int>(std::floor((bearing + kTurn / 2) / kTurn * kSectors));
     return ((k % kSectors) + kSectors) % kSectors;
   }
 };
 
 template <class Group>
 SectorIndex fileBySector(const Vec3& origin, const std::vector<Group>& groups) {
-  constexpr double kMargin = 1e-6;  // [rad] bearings at a sector's edge are filed on both sides
+  constexpr double kMargin = 1e-6;  // bearings at a sector's edge are filed on both sides
   SectorIndex index;
   index.of.resize(SectorIndex::kSectors);
   for (std::size_t gi = 0; gi < groups.size(); ++gi) {
@@ -976,11 +988,12 @@ SectorIndex fileBySector(const Vec3& origin, const std::vector<Group>& groups) {
     }
     // A box that does not hold the origin spans less than half a turn: its corners' bearings about
     // the bearing of its centre give the interval.
-    const double centre = std::atan2(0.5 * (b[2] + b[3]) - origin.y(), 0.5 * (b[0] + b[1]) - origin.x());
+    const double centre = diamondBearing(0.5 * (b[0] + b[1]) - origin.x(), 0.5 * (b[2] + b[3]) - origin.y());
     double lo = 0, hi = 0;
     for (int cx = 0; cx < 2; ++cx)
       for (int cy = 2; cy < 4; ++cy) {
-        const double rel = std::remainder(std::atan2(b[cy] - origin.y(), b[cx] - origin.x()) - centre, 2 * M_PI);
+        const double rel =
+            std::remainder(diamondBearing(b[cx] - origin.x(), b[cy] - origin.y()) - centre, SectorIndex::kTurn);
         lo = std::min(lo, rel);
         hi = std::max(hi, rel);
       }
@@ -1036,7 +1049,7 @@ std::vector<RayHit> World::castRaysOfLengths(const Vec3& origin, const std::vect
     if (!(lengths[i] > 0)) continue;
     dGeomID ray = nullptr;
     RayQuery query{ignore, &hits[i]};
-    const bool steep = std::hypot(d.x(), d.y()) < 1e-9;  // no bearing: test every group
+    const bool steep = d.x() * d.x() + d.y() * d.y() < 1e-18;  // no bearing: test every group
     const std::vector<std::size_t>& filed = steep ? sectors.all : sectors.of[sectors.sectorOf(d)];
     for (std::size_t gi : filed) {
       const CandidateGroup& g = candidate_groups_[gi];
