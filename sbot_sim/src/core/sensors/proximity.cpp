@@ -338,13 +338,15 @@ ProximitySensors::Raw ProximitySensors::rawLut(int sensor) const {
   // lie within kRobotBound of its base body's centre, so a robot culled here is culled below too.
   constexpr double kRobotBound = 0.15;  // [m] > a 5.7 cm turret radius plus the body's offset from the axis
   const dReal* me = dBodyGetPosition(robot_.baseBody());
+  const double cull = reach + 2 * kRobotBound;  // compared squared: the loop runs per sensor and robot
   bool pose_known = false;
   Pose pose, inv;
   double best = 0;
   for (Robot* other : world_.robots()) {
     if (other == &robot_) continue;
     const dReal* it = dBodyGetPosition(other->baseBody());
-    if (std::hypot(it[0] - me[0], it[1] - me[1]) - 2 * kRobotBound > reach) continue;
+    const double dx = it[0] - me[0], dy = it[1] - me[1];
+    if (dx * dx + dy * dy > cull * cull) continue;
     const double radius = turretRadius(other->description());
     if (!pose_known) {
       pose = robot_.linkPose(links_[sensor]);
