@@ -959,13 +959,14 @@ double diamondBearing(double dx, double dy) {
 }
 
 /// castRaysOfLengths' groups filed by the bearing sectors (of kSectors about the origin, equal in
-/// diamondBearing) their boxes cover; `of[k]` lists the groups a ray of sector k may cross, in
-/// group order.
+/// diamondBearing) their boxes cover; `of[k]` lists the groups a ray of sector k may cross, nearest
+/// box first.
 struct SectorIndex {
   static constexpr int kSectors = 64;
   static constexpr double kTurn = 4;  ///< a full turn in diamondBearing
   std::vector<std::vector<std::size_t>> of;
-  std::vector<std::size_t> all;  ///< every group (for rays with no bearing)
+  std::vector<std::size_t> all;  ///< every group (for rays with no bearing), nearest box first
+  std::vector<double> near;      ///< [m] each group's box's distance from the origin (0: around it)
   int sectorOf(const Vec3& d) const { return sectorOfBearing(diamondBearing(d.x(), d.y())); }
   static int sectorOfBearing(double bearing) {
     const int k = static_cast<int>(std::floor((bearing + kTurn / 2) / kTurn * kSectors));
@@ -981,6 +982,12 @@ SectorIndex fileBySector(const Vec3& origin, const std::vector<Group>& groups) {
   for (std::size_t gi = 0; gi < groups.size(); ++gi) {
     index.all.push_back(gi);
     const dReal* b = groups[gi].aabb;
+    double near2 = 0;  // (an unbounded side adds nothing: max(-inf, 0) = 0)
+    for (int k = 0; k < 3; ++k) {
+      const double outside = std::max({b[2 * k] - origin[k], 0.0, origin[k] - b[2 * k + 1]});
+      near2 += outside * outside;
+    }
+    index.near.push_back(std::sqrt(near2));
     const bool around = origin.x() >= b[0] && origin.x() <= b[1] && origin.y() >= b[2] && origin.y() <= b[3];
     if (around || !std::isfinite(b[0] + b[1] + b[2] + b[3])) {  // seen from inside, or unbounded (a plane)
       for (auto& sector : index.of) sector.push_back(gi);
@@ -1002,6 +1009,9 @@ SectorIndex fileBySector(const Vec3& origin, const std::vector<Group>& groups) {
     const int count = (span + SectorIndex::kSectors) % SectorIndex::kSectors + 1;
     for (int k = 0; k < count; ++k) index.of[(first + k) % SectorIndex::kSectors].push_back(gi);
   }
+  auto nearestFirst = [&](std::size_t a, std::size_t b) { return index.near[a] < index.near[b]; };
+  for (auto& sector : index.of) std::stable_sort(sector.begin(), sector.end(), nearestFirst);
+  std::stable_sort(index.all.begin(), index.all.end(), nearestFirst);
   return index;
 }
 
@@ -1052,10 +1062,14 @@ std::vector<RayHit> World::castRaysOfLengths(const Vec3& origin, const std::vect
     const bool steep = d.x() * d.x() + d.y() * d.y() < 1e-18;  // no bearing: test every group
     const std::vector<std::size_t>& filed = steep ? sectors.all : sectors.of[sectors.sectorOf(d)];
     for (std::size_t gi : filed) {
+      // Nearest box first: once a box lies beyond the nearest hit so far (at first, the line's
+      // end), so do all the others, and nothing in them can be nearer.
+      const double reach = hits[i].distance;
+      if (sectors.near[gi] >= reach) break;
       const CandidateGroup& g = candidate_groups_[gi];
-      if (!segmentCrosses(origin, d, lengths[i], g.aabb)) continue;
+      if (!segmentCrosses(origin, d, reach, g.aabb)) continue;
       for (std::size_t c = g.begin; c < g.end; ++c) {
-        if (g.end - g.begin > 1 && !segmentCrosses(origin, d, lengths[i], ray_candidates_[c].aabb)) continue;
+        if (g.end - g.begin > 1 && !segmentCrosses(origin, d, hits[i].distance, ray_candidates_[c].aabb)) continue;
         if (!ray) {
           ray = queryRay(lengths[i]);
           dGeomRaySet(ray, origin.x(), origin.y(), origin.z(), d.x(), d.y(), d.z());
