@@ -987,7 +987,8 @@ SectorIndex fileBySector(const Vec3& origin, const std::vector<Group>& groups) {
       const double outside = std::max({b[2 * k] - origin[k], 0.0, origin[k] - b[2 * k + 1]});
       near2 += outside * outside;
     }
-    index.near.push_back(std::sqrt(near2));
+    // A box with NaN bounds (none is known) would break the sort below: it goes first instead.
+    index.near.push_back(std::isfinite(near2) ? std::sqrt(near2) : 0.0);
     const bool around = origin.x() >= b[0] && origin.x() <= b[1] && origin.y() >= b[2] && origin.y() <= b[3];
     if (around || !std::isfinite(b[0] + b[1] + b[2] + b[3])) {  // seen from inside, or unbounded (a plane)
       for (auto& sector : index.of) sector.push_back(gi);
