@@ -85,7 +85,8 @@ double samplingRateHz(unsigned code) {
 
 // ---- per robot ----------------------------------------------------------------------------------
 
-RobotModulesRos::RobotModulesRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std::string& name)
+RobotModulesRos::RobotModulesRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std::string& name,
+                                 bool per_sensor_topics)
     : nh_(nh, name), pnh_(pnh), name_(name) {
   for (const auto& [ch, def] : channelDefaults()) {
     double hz = def;
@@ -109,8 +110,6 @@ RobotModulesRos::RobotModulesRos(ros::NodeHandle nh, ros::NodeHandle pnh, const 
   // roscpp looks a topic up linearly among all the node's publications at every publish, and a
   // recorder's subscription costs a connection each, so a large swarm runs faster without them.
   // Their rosters then never fill, so the per-sensor messages below are never built.
-  bool per_sensor_topics = true;
-  pnh_.param("per_sensor_topics", per_sensor_topics, true);
   pubs_["proximity"] = adv(Tag<sbot_msgs::ProximityArray>(), "proximity", "proximity", q, false);
   for (int k = 0; per_sensor_topics && k < sn::kProximitySensors; ++k)
     ir_pubs_.push_back(adv(Tag<sensor_msgs::Range>(), "proximity/ir_" + std::to_string(k), "ir_" + std::to_string(k), q, false));
@@ -691,6 +690,8 @@ bool RobotModulesRos::onSetSamplingRate(sbot_msgs::SetSamplingRate::Request& req
 ModulesRosInterface::ModulesRosInterface(ros::NodeHandle nh, ros::NodeHandle pnh,
                                          std::unique_ptr<sbot::World>& world, const sbot::Scenario& scenario)
     : nh_(nh), pnh_(pnh), world_(world), lamps_(scenario.lamps), ambient_(scenario.ambient_light) {
+  pnh_.param("per_sensor_topics", per_sensor_topics_, true);  // its type is checked by SimRosInterface
+  ROS_INFO("simulator: ~per_sensor_topics=%s", per_sensor_topics_ ? "true" : "false");
   ros::NodeHandle sim(nh_, "sim");
   set_lamp_srv_ = sim.advertiseService("set_lamp", &ModulesRosInterface::onSetLamp, this);
   set_ambient_srv_ = sim.advertiseService("set_ambient_light", &ModulesRosInterface::onSetAmbient, this);
@@ -723,7 +724,7 @@ bool ModulesRosInterface::checkRateParams(const ros::NodeHandle& pnh) {
 
 RobotModulesRos& ModulesRosInterface::modulesFor(const std::string& name) {
   auto& m = robots_[name];
-  if (!m) m = std::make_unique<RobotModulesRos>(nh_, pnh_, name);
+  if (!m) m = std::make_unique<RobotModulesRos>(nh_, pnh_, name, per_sensor_topics_);
   return *m;
 }
 

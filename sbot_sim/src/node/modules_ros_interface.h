@@ -65,7 +65,8 @@ double samplingRateHz(unsigned code);
 
 class RobotModulesRos {
  public:
-  RobotModulesRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std::string& name);
+  /// per_sensor_topics: ~per_sensor_topics (read once for all robots by ModulesRosInterface).
+  RobotModulesRos(ros::NodeHandle nh, ros::NodeHandle pnh, const std::string& name, bool per_sensor_topics);
   ~RobotModulesRos();
   void bind(sbot::World& world, sbot::sensors::Environment& env, sbot::Robot& robot);
   void unbind();
@@ -156,6 +157,7 @@ class ModulesRosInterface {
   double ambient_ = 0;  ///< [mcd/cm^2]
   std::unique_ptr<sbot::sensors::Environment> env_;
   std::map<std::string, std::unique_ptr<RobotModulesRos>> robots_;
+  bool per_sensor_topics_ = true;  ///< ~per_sensor_topics, for every robot's modules
   ros::ServiceServer set_lamp_srv_, set_ambient_srv_;
 };
 

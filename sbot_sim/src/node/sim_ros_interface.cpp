@@ -175,10 +175,7 @@ bool SimRosInterface::init() {
   }
   bool modules = true;  // ~modules: false = no sensor/actuator modules (benchmarking the bare node)
   pnh_.param("modules", modules, true);
-  bool per_sensor_topics = true;  // read by each robot's modules; echoed here once
-  pnh_.param("per_sensor_topics", per_sensor_topics, true);
-  ROS_INFO("simulator: ~modules=%s ~per_sensor_topics=%s", modules ? "true" : "false",
-           per_sensor_topics ? "true" : "false");
+  ROS_INFO("simulator: ~modules=%s", modules ? "true" : "false");
   if (modules) {
     modules_ = std::make_unique<ModulesRosInterface>(nh_, pnh_, world_, scenario_);
     modules_->attach();
