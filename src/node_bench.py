@@ -33,6 +33,7 @@ import sys
 import tempfile
 import time
 
+import rosgraph
 import rospkg
 
 
@@ -135,40 +136,54 @@ def drive_chains(robots, k, stats_path):
 def gate_on_recorder(exclude, stats_path):
     """The recorder's gate (a child process): the node starts paused; step it until the recorder
     starts (`rosbag record` waits for a sim clock message before it subscribes), wait until it has
-    registered a subscription to every topic the simulator publishes but the excluded ones, then
-    unpause. Writes the topic count and the seconds the subscribing took to `stats_path`."""
+    registered a subscription to every topic the simulator publishes but the excluded ones and the
+    node reports a live link to it on each, then unpause. Writes the topic count and the seconds
+    the subscribing took to `stats_path`."""
     import rospy
     from sbot_msgs.srv import Step
     from std_srvs.srv import Trigger
     rospy.init_node('node_bench_gate', anonymous=True, disable_signals=True)
     rospy.wait_for_service('/sim/step')
     start = time.time()
+    deadline = start + 120
+    ours, missing = [], []
     try:
-        topics, missing = wait_recorder_subscribed(rospy.get_name(), exclude, Step, start + 120)
+        readiness, master = start_when_ready(), rosgraph.Master(rospy.get_name())
+        ours, missing = wait_recorder_subscribed(readiness, master, exclude, Step, deadline)
+        # Registration precedes the TCP connection: wait until the node reports a live link to the
+        # recorder on every topic, with the check swarm.launch's start_when_ready uses.
+        needed = {t: 1 for t in ours}
+        while time.time() < deadline and readiness.not_ready(master, needed):
+            time.sleep(0.2)
     finally:  # whatever happened, the paused node must run (and end), or the benchmark hangs
         connected = time.time() - start
-        time.sleep(1.0)  # registration precedes the TCP connection: let the last ones connect
         rospy.ServiceProxy('/sim/unpause', Trigger)()
     with open(stats_path, 'w') as f:
-        json.dump({'topics': topics, 'missing': len(missing), 'connect_s': connected}, f)
+        json.dump({'topics': len(ours), 'missing': len(missing), 'connect_s': connected}, f)
 
 
-def wait_recorder_subscribed(caller, exclude, step_srv, deadline):
-    """Steps the paused node until the recorder starts, and polls the master until it subscribes to
-    every topic the simulator publishes but the excluded ones (or the deadline). Returns the number
-    of such topics and the list of those still missing."""
-    import rosgraph
+def start_when_ready():
+    """The start_when_ready.py beside this file, as a module (its readiness checks)."""
+    import importlib.util
+    path = os.path.join(os.path.dirname(os.path.realpath(__file__)), 'start_when_ready.py')
+    spec = importlib.util.spec_from_file_location('start_when_ready', path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def wait_recorder_subscribed(readiness, master, exclude, step_srv, deadline):
+    """Steps the paused node until the recorder starts, and polls the master (start_when_ready's
+    `registrations`) until the recorder subscribes to every topic the simulator publishes but the
+    excluded ones (or the deadline). Returns those topics and the ones still missing."""
     import rospy
     step = rospy.ServiceProxy('/sim/step', step_srv)
-    master = rosgraph.Master(caller)
     excluded = re.compile(exclude)
-    topics, missing = 0, []
+    ours, missing = [], []
     while time.time() < deadline:
-        publishers, subscribers, _ = master.getSystemState()
-        subscribed = {topic: nodes for topic, nodes in subscribers}
-        ours = [t for t, nodes in publishers if '/simulator' in nodes and not excluded.fullmatch(t)]
+        publishers, subscribed = readiness.registrations(master)
+        ours = [t for t, nodes in publishers.items() if '/simulator' in nodes and not excluded.fullmatch(t)]
         missing = [t for t in ours if not any(n.startswith('/record') for n in subscribed.get(t, []))]
-        topics = len(ours)
         if ours and not missing:
             break
         if set(ours) - set(missing) <= {'/clock'}:
@@ -176,7 +191,7 @@ def wait_recorder_subscribed(caller, exclude, step_srv, deadline):
             # (one per step, and it connects when it connects). A step per poll until it starts.
             step(1)
         time.sleep(0.2)
-    return topics, missing
+    return ours, missing
 
 
 def run(robots, seconds, scenario, chains=0, per_sensor_topics=True):
