@@ -16,7 +16,7 @@
 // --sensors: every robot's LED ring lit (red) and, at the simulator node's default 10 Hz, every
 // robot's sensors read as a controller subscribed to all of them would: the proximity ring, ground
 // and light sensors where its level has them, and the fake camera's blobs (each lit LED group of
-// another robot in range costs an occlusion ray, so this part grows with the square of the robots).
+// another robot in range costs a line of sight, so this part grows with the square of the robots).
 // The row says how many blobs a camera saw on average; --profile gives the sensors' share.
 // --profile: also print where the step time goes (World::enableProfile): solver, collision
 // detection, motor commands, feedback, and the contact joints per step.
