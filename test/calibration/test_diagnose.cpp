@@ -114,5 +114,33 @@ TEST(Diagnose, IndistinguishableEffectsAreReportedWithTheSeparatingExperiment) {
   }
 }
 
+TEST(Diagnose, ARejectedCandidateIsToldWhichAcceptanceRuleItMisses) {
+  DiagnoseOptions d;  // dBIC > 10, held-out error down >= 5 %, every fold improving
+  const std::vector<double> base{100, 100};
+  CandidateScore strong_but_small;
+  strong_but_small.delta_bic = 70.4;
+  strong_but_small.reduction = 0.048;
+  strong_but_small.all_folds_improve = true;
+  strong_but_small.fold_rss = {95, 95.4};
+  EXPECT_EQ(rejectionReason(strong_but_small, base, d), "the held-out error falls 4.8 %, less than 5 %");
+
+  CandidateScore one_fold_worse = strong_but_small;
+  one_fold_worse.reduction = 0.2;
+  one_fold_worse.all_folds_improve = false;
+  one_fold_worse.fold_rss = {60, 100};  // fold 2 no better than the current model's
+  EXPECT_EQ(rejectionReason(one_fold_worse, base, d), "fold 2 not improved");
+
+  CandidateScore worse;
+  worse.delta_bic = -9.4;
+  worse.reduction = -0.01;
+  worse.fold_rss = {101, 101};
+  EXPECT_EQ(rejectionReason(worse, base, d),
+            "dBIC -9.4 is not above 10; the held-out error rises 1 %, instead of falling >= 5 %; folds 1, 2 not improved");
+
+  CandidateScore passing = strong_but_small;
+  passing.reduction = 0.06;
+  EXPECT_EQ(rejectionReason(passing, base, d), "");
+}
+
 }  // namespace
 }  // namespace sbot::calib
