@@ -30,7 +30,7 @@ MismatchReasons MismatchReasons::load(const std::string& path, const std::string
 
 MismatchReasons MismatchReasons::none() {
   MismatchReasons r;
-  r.source_ = "no reasons file (--reasons)";
+  r.source_.clear();  // no file: fromFile() is false
   return r;
 }
 
@@ -63,7 +63,8 @@ std::string MismatchReasons::explainPending() {
     else g->second += ", *" + key + "*";
   }
   pending_.clear();
-  std::string md = "Why these cells do not match (`" + source_ + "`):\n\n";
+  std::string md = fromFile() ? "Why these cells do not match (`" + source_ + "`):\n\n"
+                              : "Why these cells do not match (no reasons file; `--reasons FILE` records them):\n\n";
   for (const auto& [reason, cells] : groups) {
     std::string one_line = reason;  // a line break would end the Markdown list item
     std::replace(one_line.begin(), one_line.end(), '\n', ' ');

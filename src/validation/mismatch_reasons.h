@@ -44,7 +44,9 @@ class MismatchReasons {
   const std::vector<std::string>& unexplained() const { return unexplained_; }
   const std::vector<std::string>& stale() const { return stale_; }
 
+  /// The reasons file as the report names it; empty for none().
   std::string source() const { return source_; }
+  bool fromFile() const { return !source_.empty(); }
 
  private:
   std::string source_;

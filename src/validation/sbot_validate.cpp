@@ -315,6 +315,7 @@ std::string shownPath(const std::string& path) {
 const auto g_start = std::chrono::steady_clock::now();
 void progress(const std::string& s) {
   const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - g_start).count();
+  std::fflush(stdout);  // the report on stdout first, so that 2>&1 does not cut it with this line
   std::fprintf(stderr, "[sbot_validate %6.0fs] %s\n", t, s.c_str());
 }
 
@@ -1052,11 +1053,13 @@ int main(int argc, char** argv) {
   if (!reasons.stale().empty())
     md << "- Recorded reasons whose cell now matches (remove them from `" << reasons.source()
        << "`): " << cells(reasons.stale()) << "\n";
-  md << "\nReference tables: `" << tables.source << "`. Each mismatch is explained under its table (from `"
-     << reasons.source() << "`)";
+  md << "\nReference tables: `" << tables.source << "`. ";
+  if (reasons.fromFile()) md << "Each mismatch is explained under its table (from `" << reasons.source() << "`)";
+  else md << "Each mismatch is listed under its table, not explained (no reasons file: `--reasons FILE`)";
   if (o.tables.empty()) md << "; the full analysis, with what was tried, is *Why cells do not match* in `src/validation/README.md`";
   md << ".\n";
   std::printf("%s", md.str().c_str());
+  std::fflush(stdout);
   try {
     sbot::writeTextFile(o.out + "/report.md", md.str());
   } catch (const std::exception& e) {  // the report is on stdout above: say so, and fail the run

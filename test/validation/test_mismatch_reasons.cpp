@@ -67,6 +67,16 @@ TEST(MismatchReasons, MismatchesGetTheirReasonOrAreFlaggedAsUnexplained) {
   EXPECT_FALSE(r.explains("4.2 45 mm"));
 }
 
+TEST(MismatchReasons, WithoutAFileMismatchesAreFlaggedAndTheOptionIsNamed) {
+  v::MismatchReasons r = v::MismatchReasons::none();
+  EXPECT_FALSE(r.fromFile());
+  EXPECT_EQ(r.record("L1 12.0 mm rev simple", false), "**mismatch**");
+  const std::string md = r.explainPending();
+  EXPECT_NE(md.find("(no reasons file; `--reasons FILE` records them)"), std::string::npos) << md;
+  EXPECT_NE(md.find("*L1 12.0 mm rev simple*: **not explained yet**"), std::string::npos) << md;
+  EXPECT_EQ(md.find("``"), std::string::npos) << "no empty file name: " << md;
+}
+
 TEST(MismatchReasons, MalformedFilesAreRefusedWithTheFileAndTheProblem) {
   EXPECT_NE(refusal("- a list\n- not a map\n").find("expected a map"), std::string::npos);
   EXPECT_NE(refusal("\"4.2 55 mm\": [1, 2]\n").find("the reason for '4.2 55 mm' is not a text"), std::string::npos);
