@@ -54,8 +54,9 @@ class Robot {
   void getSpeed(int* left, int* right) const;
   /// Track motor torques, API units (2.4412 mN m), in [-127,127]: trackTorqueLeft/Right.
   void getTrackTorque(int* left, int* right) const;
-  /// [m] lateral distance between the left and right driven wheels (mean of each side), measured
-  /// on the built model; the seed's 0.082 m (Table 2.2) if the wheels are not apart.
+  /// [m] lateral distance between the left and right outermost driven wheels (the treels' centre
+  /// wheels, on which the robot turns), measured on the built model: 0.082 m at full size (Table
+  /// 2.2), 0.041 m for Fast; the seed's 0.082 m if the wheels are not apart. cmd_vel's b.
   double trackWidth() const { return track_width_; }
   /// Passive treels (seed TreelsModule::setPassive): motors off, only the gear back-drive friction
   /// (treels.backdrive_force) resists rolling. Any setSpeed() makes them active again.
