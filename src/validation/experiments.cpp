@@ -633,6 +633,25 @@ Outcome steadySpeedTrial(const std::string& level, int units) {
   return o;
 }
 
+Outcome spinRateTrial(const std::string& level, int units) {
+  const RobotDescription& d = loadLevel(level);
+  World w(configFor(d, 8));
+  Robot& r = spawn(w, d, {0, 0, 0});
+  r.setSpeed(units, -units);
+  runFor(w, 1.0, [] { return false; });  // past the acceleration phase
+  double turned = 0, last = headingOf(r);
+  const int n = static_cast<int>(std::lround(3.0 / w.config().step));
+  for (int i = 0; i < n; ++i) {
+    w.step();
+    turned += std::remainder(headingOf(r) - last, 2 * M_PI);
+    last = headingOf(r);
+  }
+  Outcome o{"ok"};
+  o.value = -turned / 3.0;  // left forward, right back: clockwise, negative yaw
+  o.value2 = 2 * units * d.treels.speed_unit / r.trackWidth();
+  return o;
+}
+
 Outcome connectedPairTrial(const std::string& level) {
   const RobotDescription& d = loadLevel(level);
   WorldConfig c = configFor(d, 9);
@@ -692,6 +711,8 @@ const std::vector<ExperimentKind>& experimentKinds() {
       {"rtm", "simulated time, s", 0.1, 3600.0, {}, {"real-time multiplier", ""}, {"wall time per step", "ms"}, [](const std::string& l, double p, int, const Drive&) { return rtmTrial(l, p); }},
       {"speed", "setSpeed units", -70.0, 70.0, {}, {"steady speed", "m/s"}, {},
        [](const std::string& l, double p, int, const Drive&) { return steadySpeedTrial(l, static_cast<int>(std::lround(p))); }},
+      {"spin", "setSpeed units (left forward, right back)", -70.0, 70.0, {}, {"spin rate", "rad/s"}, {"2 v / trackWidth", "rad/s"},
+       [](const std::string& l, double p, int, const Drive&) { return spinRateTrial(l, static_cast<int>(std::lround(p))); }},
   };
   return kinds;
 }

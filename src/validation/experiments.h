@@ -152,6 +152,11 @@ StepCost profileTrial(const std::string& level, double sim_seconds);
 /// Seed 2.1.3: steady speed [m/s] at setSpeed(units, units) on flat ground (value).
 Outcome steadySpeedTrial(const std::string& level, int units);
 
+/// Turning, the part of "a similar behaviour for the same command" (2.1.3) the speed band
+/// leaves out: spin rate [rad/s] at setSpeed(units, -units) on flat ground over 3 s after 1 s
+/// (value, clockwise positive), and the rate 2 v / Robot::trackWidth that cmd_vel assumes (value2).
+Outcome spinRateTrial(const std::string& level, int units);
+
 /// Seed 2.1.3, the other half of compatibility: two s-bots of `level` on flat ground, the second
 /// held by the first's front gripper (a static link, swarm/swarm_graph.h), stand 1 s, then reverse
 /// together at 30 units for 2 s. value = their centre-to-centre distance after standing [m],
