@@ -192,11 +192,11 @@ std::string rejectionReason(const CandidateScore& s, const std::vector<double>& 
                      fmt(100 * opt.min_reduction, 3) + " %");
   if (!s.all_folds_improve) {
     std::string worse;
+    int count = 0;
     for (std::size_t f = 0; f < s.fold_rss.size() && f < base_fold_rss.size(); ++f)
-      if (!(s.fold_rss[f] < base_fold_rss[f])) worse += (worse.empty() ? "" : ", ") + std::to_string(f + 1);
-    misses.push_back(worse.empty() ? std::string("not every fold improves")
-                                   : "fold" + std::string(worse.find(',') == std::string::npos ? " " : "s ") + worse +
-                                         " not improved");
+      if (!(s.fold_rss[f] < base_fold_rss[f])) worse += (count++ ? ", " : "") + std::to_string(f + 1);
+    misses.push_back(count == 0 ? "not every fold improves"
+                                : (count == 1 ? "fold " : "folds ") + worse + " not improved");
   }
   std::string out;
   for (const auto& m : misses) out += (out.empty() ? "" : "; ") + m;

@@ -119,7 +119,7 @@ int foldCount(const Dataset& ds, int folds);
 std::vector<int> assignFolds(const Dataset& ds, int folds, std::uint64_t seed);
 
 /// Which of the acceptance rules a candidate misses (for the verdict's "best rejected candidate"),
-/// each named with its number: "dBIC 3.2 is not above 10", "the held-out error falls 4.8 %, less
+/// each in words: "dBIC 3.2 is not above 10", "the held-out error falls 4.8 %, less
 /// than 5 %", "fold 2 not improved" (against `base_fold_rss`, the current model's held-out RSS
 /// per fold). Empty when it passes them all.
 std::string rejectionReason(const CandidateScore& s, const std::vector<double>& base_fold_rss,

@@ -639,15 +639,16 @@ Outcome spinRateTrial(const std::string& level, int units) {
   Robot& r = spawn(w, d, {0, 0, 0});
   r.setSpeed(units, -units);
   runFor(w, 1.0, [] { return false; });  // past the acceleration phase
+  constexpr double kSpan = 3.0;           // [s] measured
   double turned = 0, last = headingOf(r);
-  const int n = static_cast<int>(std::lround(3.0 / w.config().step));
+  const int n = static_cast<int>(std::lround(kSpan / w.config().step));
   for (int i = 0; i < n; ++i) {
     w.step();
     turned += std::remainder(headingOf(r) - last, 2 * M_PI);
     last = headingOf(r);
   }
   Outcome o{"ok"};
-  o.value = -turned / 3.0;  // left forward, right back: clockwise, negative yaw
+  o.value = -turned / kSpan;  // left forward, right back: clockwise, negative yaw
   o.value2 = 2 * units * d.treels.speed_unit / r.trackWidth();
   return o;
 }

@@ -29,9 +29,7 @@ MismatchReasons MismatchReasons::load(const std::string& path, const std::string
 }
 
 MismatchReasons MismatchReasons::none() {
-  MismatchReasons r;
-  r.source_.clear();  // no file: fromFile() is false
-  return r;
+  return MismatchReasons();  // no source: fromFile() is false
 }
 
 std::vector<std::string> MismatchReasons::keys() const {

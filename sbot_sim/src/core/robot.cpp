@@ -246,13 +246,11 @@ void Robot::measureTrackWidth() {
   const Pose base_inv = basePose().inverse();
   auto outermost_y = [&](const std::vector<int>& side) {
     double best = 0;
-    bool any = false;
     for (int i : side) {
       const JointDescription* j = description_->findJoint(hinges_[i].name);
       if (!j || !hasLink(j->child)) continue;
       const double y = (base_inv * linkPose(j->child)).position.y();
-      if (!any || std::abs(y) > std::abs(best)) best = y;
-      any = true;
+      if (std::abs(y) > std::abs(best)) best = y;
     }
     return best;
   };

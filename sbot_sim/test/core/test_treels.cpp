@@ -27,6 +27,17 @@ std::pair<Vec3, Vec3> steadyStretchAt50(World& w, Robot& r) {
   return {p0, r.basePose().position};
 }
 
+/// The yaw [rad] the robot turns over the next `steps` steps, unwrapped (> 0 counter-clockwise).
+double turnedOver(World& w, const Robot& r, int steps) {
+  double turned = 0, last = r.basePose().yaw();
+  for (int i = 0; i < steps; ++i) {
+    w.step();
+    turned += wrapAngle(r.basePose().yaw() - last);
+    last = r.basePose().yaw();
+  }
+  return turned;
+}
+
 TEST(Treels, Speed50Gives14cmPerSecond) {
   World w(flatWorld());
   Robot& r = w.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_0");
@@ -248,13 +259,7 @@ TEST(Treels, SpinDoesNotDependOnTheStartHeading) {
       Robot& r = w.addRobot(loadLevel(level), {0, 0, yaw0}, "sbot_0");
       runFor(w, 0.3);
       r.setSpeed(30, -30);
-      double last = r.basePose().yaw(), sum = 0;
-      for (int k = 0; k < 300; ++k) {
-        w.step();
-        sum += wrapAngle(r.basePose().yaw() - last);
-        last = r.basePose().yaw();
-      }
-      turned.push_back(sum);
+      turned.push_back(turnedOver(w, r, 300));
     }
     const auto [lo, hi] = std::minmax_element(turned.begin(), turned.end());
     std::printf("%s spin 3 s from 0/22.5/45 deg: %.1f %.1f %.1f deg\n", level.c_str(), turned[0] * 180 / M_PI,
@@ -438,13 +443,7 @@ TEST(Treels, TrackWidthIsTheWidthTheRobotTurnsOn) {
     runFor(w, 0.5);
     r.setSpeed(10, -10);
     runFor(w, 1.0);
-    double turned = 0, last = r.basePose().yaw();
-    const int n = static_cast<int>(std::lround(3.0 / w.config().step));
-    for (int i = 0; i < n; ++i) {
-      w.step();
-      turned += wrapAngle(r.basePose().yaw() - last);
-      last = r.basePose().yaw();
-    }
+    const double turned = turnedOver(w, r, static_cast<int>(std::lround(3.0 / w.config().step)));
     const double commanded = 2 * 10 * d.treels.speed_unit / r.trackWidth();
     EXPECT_NEAR(std::abs(turned) / 3.0, commanded, 0.05 * commanded) << level;
   }
@@ -469,13 +468,8 @@ TEST(TreelsFast, SpinsAtTheDifferentialDriveRate) {
   Robot& r = w.addRobot(loadLevel("fast"), {0, 0, 0}, "sbot_0");
   r.setSpeed(-20, 20);
   runFor(w, 1.0);
-  double turned = 0, last = r.basePose().yaw();
   const Vec3 start = r.basePose().position;
-  for (int i = 0; i < 20; ++i) {  // 2 s
-    w.step();
-    turned += wrapAngle(r.basePose().yaw() - last);
-    last = r.basePose().yaw();
-  }
+  const double turned = turnedOver(w, r, 20);  // 2 s
   // Wheels 4.1 cm apart: yaw rate = 2 * 20 * 2.8 mm/s / 0.041 m = 2.73 rad/s.
   EXPECT_NEAR(turned / 2.0, 2 * 20 * 0.0028 / 0.041, 0.05 * 2.73);
   EXPECT_LT((r.basePose().position - start).head<2>().norm(), 0.005) << "on the spot";
