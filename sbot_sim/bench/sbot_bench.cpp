@@ -46,6 +46,7 @@
 #include "sbot_sim/core/swarm/swarm_graph.h"
 #include "sbot_sim/core/world.h"
 #include "sbot_sim/tools/cli_args.h"
+#include "sbot_sim/tools/machine.h"
 
 namespace {
 
@@ -285,6 +286,8 @@ int main(int argc, char** argv) {
     std::printf("sbot_bench: headless core, scenario %s, %s, 1 core per run\n", o.scenario.c_str(),
                 o.idle ? "idle" : "random walk");
   }
+  // Every figure below depends on the processor: name it (sbot_sim/tools/machine.h).
+  std::printf("sbot_bench: machine: %s\n", sbot_tools::describeThisMachine().c_str());
   std::printf("%-8s %7s %10s %12s %14s %12s\n", "level", "robots", "sim_s", "RTM", "wall_ms/step", "peak_MiB");
   std::fflush(stdout);
   int failures = 0;

@@ -56,6 +56,7 @@
 #include "mismatch_reasons.h"
 #include "reference_tables.h"
 #include "sbot_sim/tools/cli_args.h"
+#include "sbot_sim/tools/machine.h"
 #include "two_sbots_trials.h"
 #include "sbot_sim/core/output_files.h"
 #include "sbot_sim/core/robot_description.h"
@@ -440,6 +441,7 @@ struct RtmRuns {
   std::map<std::string, double> slowest;  ///< per level, with sensors: how steady the machine was
   std::map<std::string, v::StepCost> profile;  ///< per level: the profiled run whose solver was fastest
   double load[3] = {0, 0, 0};             ///< load average before the runs
+  std::string machine;                    ///< processor and cores (sbot_tools::describeThisMachine)
 };
 RtmRuns measureRtm(const Options& o) {
   RtmRuns runs;
@@ -448,6 +450,7 @@ RtmRuns measureRtm(const Options& o) {
   auto& load = runs.load;
   progress("Table 4.4: real-time multiplier");
   getloadavg(load, 3);
+  runs.machine = sbot_tools::describeThisMachine();
   // One run at a time (the trials time themselves), the fastest kept. The repeats go round the
   // levels, so each level's runs are spread over the whole measurement (the VM's slow spells last
   // up to a minute: back-to-back repeats fell into the same one).
@@ -486,9 +489,10 @@ void writeRtm(std::ostream& md, const Options& o, const RtmRuns& runs) {
         "ground and light sensors where the level has them (SensorSuite). The last column is the same "
         "run without any sensor reads. Each RTM is the best of " << kRtmRepeats << " runs, taken in turns with the "
         "other levels' (another process on the machine can only slow a run down, and this VM's slow spells "
-        "last up to a minute); the slowest of the " << kRtmRepeats << " shows how steady the machine was. Machine load average when measured: " << fmt(load[0]) << " on "
-     << sysconf(_SC_NPROCESSORS_ONLN) << " cores (above ~1, other processes share the CPU and these RTMs are "
-        "pessimistic).\n\n"
+        "last up to a minute); the slowest of the " << kRtmRepeats << " shows how steady the machine was. Machine: " << runs.machine
+     << " (RTMs scale with the processor: other machines' figures are in "
+        "docs/results/performance_history.md); load average when measured: " << fmt(load[0])
+     << " (above ~1, other processes share the CPU and these RTMs are pessimistic).\n\n"
      << "| level | step | solver iterations | seed RTM | target (10x) | ours RTM | slowest run | wall ms/step | target met | physics only RTM |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& level : kLevels) {
     const v::Outcome& r = fastest.at(level)[0];

@@ -1,7 +1,7 @@
 // The headless tools' options (sbot_validate, switching_experiment, two_sbots; sbot_sim/tools/cli_args.h):
 // a missing value, or a value that is not a number in range, is refused with exit status 2 and a
 // message that names the option and what was found (atoi/atof used to turn "abc" into a silent 0 runs
-// or trials).
+// or trials); and the machine they name beside their figures (sbot_sim/tools/machine.h).
 #include <gtest/gtest.h>
 #include <fcntl.h>
 #include <signal.h>
@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "../common/run_process.h"
+#include "sbot_sim/tools/machine.h"
 
 namespace {
 
@@ -102,6 +103,25 @@ TEST(ToolsCli, BenchRunsAScenarioFile) {
   std::istringstream f(row(fewer.output));
   f >> level >> robots;
   EXPECT_EQ(robots, 3) << fewer.output;  // the two listed and one of the swarm block
+}
+
+// A benchmark figure names the machine it was measured on: the first processor's model and BogoMIPS
+// from /proc/cpuinfo, and the online cores (a field the file lacks is left out, not guessed).
+TEST(ToolsCli, TheMachineIsNamedFromCpuinfo) {
+  std::istringstream x86(
+      "processor\t: 0\nvendor_id\t: AuthenticAMD\nmodel name\t: AMD EPYC 7B13 64-Core Processor\n"
+      "cpu MHz\t\t: 2445.404\nbogomips\t: 4890.80\n\n"
+      "processor\t: 1\nmodel name\t: another model\nbogomips\t: 1.00\n");
+  EXPECT_EQ(sbot_tools::describeProcessor(x86, 2), "AMD EPYC 7B13 64-Core Processor, 2 cores, BogoMIPS 4890.80");
+  std::istringstream arm("processor\t: 0\nBogoMIPS\t: 50.00\r\nFeatures\t: fp asimd\nCPU implementer\t: 0x41\n");
+  EXPECT_EQ(sbot_tools::describeProcessor(arm, 1), "unknown processor, 1 core, BogoMIPS 50.00");
+  std::istringstream none("");
+  EXPECT_EQ(sbot_tools::describeProcessor(none, 0), "unknown processor");
+  // sbot_bench prints it above its rows.
+  const Outcome o = sbot_test::runProcess(std::string(SBOT_BENCH_BIN) + " --robots 1 --seconds 0.1");
+  ASSERT_EQ(o.status, 0) << o.output;
+  EXPECT_NE(o.output.find("sbot_bench: machine: " + sbot_tools::describeThisMachine() + "\n"), std::string::npos)
+      << o.output;
 }
 
 // --idle: the robots stand, fall asleep in the untimed settling, and only --seconds are timed; a

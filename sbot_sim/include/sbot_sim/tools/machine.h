@@ -1,0 +1,51 @@
+// The machine a benchmark figure was measured on, printed beside it by the headless tools
+// (sbot_bench's header line, sbot_validate's Table 4.4). A real-time multiplier means little without
+// it: the same build ran Table 4.4 40-50 % slower on one 2-core VM than on another
+// (docs/results/performance_history.md, 2026-12-07).
+#pragma once
+
+#include <unistd.h>
+
+#include <fstream>
+#include <istream>
+#include <sstream>
+#include <string>
+
+namespace sbot_tools {
+
+/// "MODEL, N cores, BogoMIPS B" from the text of /proc/cpuinfo (x86: "model name" and "bogomips"
+/// lines; a field missing is left out, and a processor that names no model is "unknown processor").
+inline std::string describeProcessor(std::istream& cpuinfo, long cores) {
+  std::string model, bogomips, line;
+  auto valueOf = [](const std::string& l) {
+    const std::size_t colon = l.find(':');
+    std::string v = colon == std::string::npos ? "" : l.substr(colon + 1);
+    const std::size_t first = v.find_first_not_of(" \t");
+    const std::size_t last = v.find_last_not_of(" \t\r");
+    return first == std::string::npos ? std::string() : v.substr(first, last - first + 1);
+  };
+  auto key = [](const std::string& l) {
+    const std::size_t colon = l.find(':');
+    const std::string k = l.substr(0, colon == std::string::npos ? l.size() : colon);
+    const std::size_t last = k.find_last_not_of(" \t");
+    return last == std::string::npos ? std::string() : k.substr(0, last + 1);
+  };
+  while (std::getline(cpuinfo, line)) {  // the first processor's lines name them all
+    const std::string k = key(line);
+    if (model.empty() && k == "model name") model = valueOf(line);
+    if (bogomips.empty() && (k == "bogomips" || k == "BogoMIPS")) bogomips = valueOf(line);
+  }
+  std::ostringstream out;
+  out << (model.empty() ? "unknown processor" : model);
+  if (cores > 0) out << ", " << cores << (cores == 1 ? " core" : " cores");
+  if (!bogomips.empty()) out << ", BogoMIPS " << bogomips;
+  return out.str();
+}
+
+/// This machine, as describeProcessor reads it from /proc/cpuinfo and the online core count.
+inline std::string describeThisMachine() {
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  return describeProcessor(cpuinfo, sysconf(_SC_NPROCESSORS_ONLN));
+}
+
+}  // namespace sbot_tools
