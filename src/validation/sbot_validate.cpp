@@ -200,7 +200,9 @@ std::string backwardStepStatics() {
         "the gtest StepStatics.PredictsWhere... checks it). The hardware's limit (15 mm passes, 16 mm fails) takes the centre of mass at most "
      << cm(needed.com_x) << " cm ahead of the centre axle at the same height: the turret's own COM "
      << cm(std::abs(turret_shift)) << " cm further " << (turret_shift >= 0 ? "back" : "forward")
-     << " than ours (Table 2.3: 4 +- 1 cm ahead of the turret axis). With it the rigid static tip "
+     << " than ours (Table 2.3: 4 +- 1 cm ahead of the turret axis); or, as far ahead as ours, at most "
+     << cm(v::comZForCornerTip(s, hardware_tip)) << " cm above the centre axle instead of " << cm(s.com_z)
+     << " (the centre wheels alone are " << cm(2 * s.centre_radius) << " cm high). With the first the rigid static tip "
         "facing downhill rises from " << deg(v::frontTipSlope(s)) << " to " << deg(v::frontTipSlope(needed))
      << " deg (hardware: \"difficult\" at 20 deg and toppling at 30 deg rear uphill; src/validation/README.md, "
         "*Step statics*, has the trials with such a centre of mass).\n\n";

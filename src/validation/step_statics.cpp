@@ -51,6 +51,12 @@ double comXForCornerTip(SideView s, double h) {
   return cornerMargin(s, h) / std::cos(pitchOnStep(s, h));
 }
 
+double comZForCornerTip(SideView s, double h) {
+  // cornerMargin is linear in com_z with slope -sin p (p > 0 on any step): solve directly.
+  s.com_z = 0;
+  return cornerMargin(s, h) / std::sin(pitchOnStep(s, h));
+}
+
 double frontTipSlope(const SideView& s) {
   const double ground = -s.front_axle_z + s.front_radius;  // centre axle height above the front contact
   return std::atan2(s.front_axle_x - s.com_x, s.com_z + ground);

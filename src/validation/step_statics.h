@@ -37,6 +37,10 @@ double cornerTipHeight(const SideView& s);
 /// to tip on a step `h` [m] high.
 double comXForCornerTip(SideView s, double h);
 
+/// The height of the centre of mass above the centre axle [m] (at its ahead offset s.com_x) at which
+/// the robot starts to tip on a step `h` [m] high: the other way to move it behind the corner.
+double comZForCornerTip(SideView s, double h);
+
 /// Static tipping angle [rad] on a slope, facing downhill, over the front wheel's contact.
 double frontTipSlope(const SideView& s);
 

@@ -197,8 +197,14 @@ TEST(StepStatics, TheCentreOfMassAheadOfTheCornerTipsTheRobot) {
   EXPECT_NEAR(v::cornerMargin(s, 0.01), 0.0, 1e-12);
   EXPECT_NEAR(v::cornerTipHeight(s), 0.01, 1e-6);
   EXPECT_NEAR(v::comXForCornerTip(s, 0.01), s.com_x, 1e-12);
+  EXPECT_NEAR(v::comZForCornerTip(s, 0.01), s.com_z, 1e-12);
   s.com_x -= 0.002;  // further back: it takes a higher step to tip it
   EXPECT_GT(v::cornerTipHeight(s), 0.011);
+  // Lower: likewise (pitched nose down, a lower centre of mass swings less far forward).
+  v::SideView low = s;
+  low.com_z = 0.015;
+  EXPECT_GT(v::cornerTipHeight(low), v::cornerTipHeight(s));
+  EXPECT_LT(v::comZForCornerTip(s, 0.015), s.com_z);
   // Facing downhill it tips when the COM passes over the front wheel's contact: atan((x_f - x) / (z + r)).
   EXPECT_NEAR(v::frontTipSlope(s), std::atan2(0.04 - s.com_x, 0.045), 1e-12);
 }
