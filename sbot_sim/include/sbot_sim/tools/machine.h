@@ -16,24 +16,17 @@ namespace sbot_tools {
 /// "MODEL, N cores, BogoMIPS B" from the text of /proc/cpuinfo (x86: "model name" and "bogomips"
 /// lines; a field missing is left out, and a processor that names no model is "unknown processor").
 inline std::string describeProcessor(std::istream& cpuinfo, long cores) {
+  auto trim = [](const std::string& t) {
+    const std::size_t first = t.find_first_not_of(" \t\r");
+    return first == std::string::npos ? std::string() : t.substr(first, t.find_last_not_of(" \t\r") - first + 1);
+  };
   std::string model, bogomips, line;
-  auto valueOf = [](const std::string& l) {
-    const std::size_t colon = l.find(':');
-    std::string v = colon == std::string::npos ? "" : l.substr(colon + 1);
-    const std::size_t first = v.find_first_not_of(" \t");
-    const std::size_t last = v.find_last_not_of(" \t\r");
-    return first == std::string::npos ? std::string() : v.substr(first, last - first + 1);
-  };
-  auto key = [](const std::string& l) {
-    const std::size_t colon = l.find(':');
-    const std::string k = l.substr(0, colon == std::string::npos ? l.size() : colon);
-    const std::size_t last = k.find_last_not_of(" \t");
-    return last == std::string::npos ? std::string() : k.substr(0, last + 1);
-  };
   while (std::getline(cpuinfo, line)) {  // the first processor's lines name them all
-    const std::string k = key(line);
-    if (model.empty() && k == "model name") model = valueOf(line);
-    if (bogomips.empty() && (k == "bogomips" || k == "BogoMIPS")) bogomips = valueOf(line);
+    const std::size_t colon = line.find(':');
+    if (colon == std::string::npos) continue;
+    const std::string key = trim(line.substr(0, colon));
+    if (model.empty() && key == "model name") model = trim(line.substr(colon + 1));
+    if (bogomips.empty() && (key == "bogomips" || key == "BogoMIPS")) bogomips = trim(line.substr(colon + 1));
   }
   std::ostringstream out;
   out << (model.empty() ? "unknown processor" : model);
