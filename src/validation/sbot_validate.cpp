@@ -204,7 +204,7 @@ std::string backwardStepStatics() {
      << cm(v::comZForCornerTip(s, hardware_tip)) << " cm above the centre axle instead of " << cm(s.com_z)
      << " (the centre wheels alone are " << cm(2 * s.centre_radius) << " cm high). With the first the rigid static tip "
         "facing downhill rises from " << deg(v::frontTipSlope(s)) << " to " << deg(v::frontTipSlope(needed))
-     << " deg (hardware: \"difficult\" at 20 deg and toppling at 30 deg rear uphill; src/validation/README.md, "
+     << " deg (hardware: \"difficult\" at 20 deg and toppling at 30 deg rear uphill; docs/validation.md, "
         "*Step statics*, has the trials with such a centre of mass).\n\n";
   return md.str();
 }
@@ -1082,7 +1082,7 @@ int main(int argc, char** argv) {
   md << "\nReference tables: `" << tables.source << "`. ";
   if (reasons.fromFile()) md << "Each mismatch is explained under its table (from `" << reasons.source() << "`)";
   else md << "Each mismatch is listed under its table, not explained (no reasons file: `--reasons FILE`)";
-  if (o.tables.empty()) md << "; the full analysis, with what was tried, is *Why cells do not match* in `src/validation/README.md`";
+  if (o.tables.empty()) md << "; the analysis behind them is *Why cells do not match* in `docs/validation.md`";
   md << ".\n";
   std::printf("%s", md.str().c_str());
   std::fflush(stdout);

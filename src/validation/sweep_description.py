@@ -12,7 +12,7 @@ grid would be too large; --seed makes the draw repeatable), and the best variant
 end by the cells they match. Its URDFs and sidecars are generated into a directory
 of their own, and `sbot_validate` runs the sections on them through $SBOT_DESCRIPTION_DIR, so the
 source tree is never touched. One line per variant: the cells matched per group and the mismatched
-cells. --tables runs your own reference tables (sbot_validate --tables; src/validation/README.md)
+cells. --tables runs your own reference tables (sbot_validate --tables; docs/validation.md)
 instead of the seed's, all of their sections unless --only names some: a parameter swept against
 your own measurements.
 
