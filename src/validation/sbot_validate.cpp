@@ -493,7 +493,7 @@ void writeRtm(std::ostream& md, const Options& o, const RtmRuns& runs) {
         "other levels' (another process on the machine can only slow a run down, and this VM's slow spells "
         "last up to a minute); the slowest of the " << kRtmRepeats << " shows how steady the machine was. Machine: " << runs.machine
      << " (RTMs scale with the processor: other machines' figures are in "
-        "docs/results/performance_history.md); load average when measured: " << fmt(load[0])
+        "docs/benchmarks.md); load average when measured: " << fmt(load[0])
      << " (above ~1, other processes share the CPU and these RTMs are pessimistic).\n\n"
      << "| level | step | solver iterations | seed RTM | target (10x) | ours RTM | slowest run | wall ms/step | target met | physics only RTM |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& level : kLevels) {

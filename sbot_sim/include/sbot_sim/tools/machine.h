@@ -1,7 +1,7 @@
 // The machine a benchmark figure was measured on, printed beside it by the headless tools
 // (sbot_bench's header line, sbot_validate's Table 4.4). A real-time multiplier means little without
 // it: the same build ran Table 4.4 40-50 % slower on one 2-core VM than on another
-// (docs/results/performance_history.md, 2026-12-07).
+// (docs/benchmarks.md, the Table 4.4 rows of two machines).
 #pragma once
 
 #include <unistd.h>
