@@ -11,7 +11,7 @@ its first step, whatever the machine's speed.
 Why the second wait: the master lists a subscriber as soon as it registers, but messages reach it
 only once the publisher has accepted its connection. With 20 robots rosbag registers ~120 topics
 in 0.2 s and the connections follow one by one; unpaused at registration, a loaded 2-core machine
-recorded nothing of six robots' ground truth in a 30 s demo (2026-11-27).
+can record nothing of six robots' ground truth in a 30 s demo (test/test_swarm_record.py).
 
 Private parameters:
   ~robots           int   number of robots sbot_0 .. sbot_<n-1> (required)

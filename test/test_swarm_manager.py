@@ -4,7 +4,7 @@ swarm_manager keeps it Basic on the flat start, switches it to Medium before the
 x = 1.5 m and back to Basic behind it. A manual override pins the level.
 
 The test steers (proportional on heading and lateral offset, like the course experiment's route
-follower): open loop, the quickstep solver's yaw drift (README, "Known limits") takes the robot to
+follower): open loop, the quickstep solver's yaw drift (docs/model.md, "Yaw drift under quickstep") takes the robot to
 the 0.5 m wide course's side edge, which the manager rightly reads as a drop."""
 import math
 import threading

@@ -90,8 +90,8 @@ class SwarmRecordTest(unittest.TestCase):
     def test_2_plausible_counts(self):
         counts = self.topics()
         # State topics: publish_rate over the whole run, from its first step (start_when_ready waits
-        # for the recorder's connections before it unpauses; 2026-11-27 the demo lost all of six
-        # robots' ground truth when it waited for their registration only), never more than the run
+        # for the recorder's connections before it unpauses; waiting for their registration only,
+        # the demo can lose all of six robots' ground truth), never more than the run
         # could produce. Clock: every 10 ms step. Controllers: 10 Hz.
         state = self.duration * self.publish_rate
         bounds = {'/clock': (0.5 * self.duration * 100, 1.1 * self.duration * 100 + 5)}

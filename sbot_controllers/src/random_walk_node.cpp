@@ -5,7 +5,7 @@
 // until it points inward again. (It uses ground truth until the IR sensors arrive.)
 //
 // Subscribes: ground_truth (nav_msgs/Odometry).  Publishes: cmd_speed (sbot_msgs/TrackSpeed).
-// In the simulator's lock-step (~lockstep true, README "Lock-step") it acts on the first ground truth
+// In the simulator's lock-step (~lockstep true, docs/ros_api.md "Lock-step") it acts on the first ground truth
 // at or after each control tick (k / rate, k = 1, 2, ...) and then tells the simulator it waits for
 // the next tick, so the simulator holds until its command has arrived; otherwise a sim-time timer.
 // Private parameters (echoed at start):

@@ -454,8 +454,8 @@ void initSwarmBot(void (*errorHandler)(const char*), void (*warningHandler)(cons
   g->speed_pub = g->nh->advertise<sbot_msgs::TrackSpeed>("cmd_speed", 10);
   g->speaker_pub = g->nh->advertise<std_msgs::Float64>("speaker", 10, true);
   // Every service the API calls: the simulator advertises them one after another, so one being up
-  // does not mean the others are (a first setTurretRotation right after set_gripper appeared failed,
-  // 2026-11-27, rostest sbot_api_avoidance). 30 s for them all.
+  // does not mean the others are (a first setTurretRotation right after set_gripper appeared can
+  // fail; rostest sbot_api_avoidance). 30 s for them all.
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(30.0);
   for (const char* service : {"set_gripper", "set_side_arm", "set_leds", "set_sampling_rate", "set_turret"}) {
     const std::string probe = g->nh->resolveName(service);

@@ -485,7 +485,7 @@ def build(level, p):
 
 
 def build_side_arm(rb, a, materials):
-    """Scissor side arm (see README "Side arm"). Returns the sidecar `side_arm` block."""
+    """Scissor side arm (see sbot_description/README.md "Side arm"). Returns the sidecar `side_arm` block."""
     az, s, a0 = a["azimuth_rad"], a["link_length_m"], a["rest_half_angle_rad"]
     lw, lt, lo = a["link_width_m"], a["link_thickness_m"], a["layer_offset_m"]
     mat = a["material"]

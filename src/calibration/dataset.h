@@ -116,7 +116,7 @@ struct Dataset {
   /// Terrain including the obstacles (as boxes with their surface labels). Sleeping at rest
   /// (RestConfig) is off unless the dataset's world says `sleep_at_rest: true`: a fit needs the
   /// replay to be a smooth function of the effects' parameters, and sleep switches on a threshold
-  /// (with it a speed_scale + latency diagnosis settled on motor lag for one seed of two, 2026-12-01).
+  /// (with it a speed_scale + latency diagnosis settles on motor lag for one seed of two).
   WorldConfig world = workbenchWorld();
   /// world.step / world.gravity written in the dataset: replays use them; otherwise the model
   /// level's recommended step and gravity (Fast: 0.1 s, 1/50 g).

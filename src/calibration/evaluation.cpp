@@ -359,8 +359,8 @@ ReplayableRounds solveOnReplayableRuns(const Dataset& ds, const ModelSpec& start
     // A re-admitted run can be reproducible at round 1's values only: the fits of round 2, which start
     // from the start model and move through chaotic values, then lose the effect round 1 found
     // (Medium torque saturation lost 2 of 5 so). Adding runs must add evidence, not take it away.
-    // (Letting such a round stand when its own model replays the runs it took back, tried 2026-11-29,
-    // dropped a true latency on Fast for a spurious effect dropped elsewhere: docs/calibration.md.)
+    // (Letting such a round stand when its own model replays the runs it took back drops a true
+    // latency on Fast in one seed of the sweep for a spurious effect dropped elsewhere.)
     if (const std::vector<std::string> lost = effectsLost(solved, next_solved); !lost.empty()) {
       out.note = "round " + std::to_string(next.round) + " ended without " + nameList(lost) + ", which round " +
                  std::to_string(out.round) + " found: the runs re-admitted are not reproducible away from its values, "

@@ -90,8 +90,8 @@ struct ReplaySensitivity {
   std::string worst_channel;    ///< the channel that moved most
   double worst_nrms = 0;        ///< its RMS in noise units
 };
-/// The start moves by this many sigma of the tracker's noise. It was 0.01 until 2026-11-28: too small
-/// for a robot near a tipping threshold (a Fast arc that the true model replays at nRMS 34 read 0.4).
+/// The start moves by this many sigma of the tracker's noise. A much smaller nudge (0.01) misses a
+/// robot near a tipping threshold (a Fast arc that the true model replays at nRMS 34 reads 0.4).
 constexpr double kStartNudge = 1.0;
 constexpr double kChaoticSensitivity = 1.0;  ///< above: the start moved the prediction more than the noise
 

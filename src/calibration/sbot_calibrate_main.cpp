@@ -142,7 +142,7 @@ Args parse(int argc, char** argv) {
       s = s.substr(2);
       const auto eq = s.find('=');
       if (eq != std::string::npos) {
-        if (kFlags.count(s.substr(0, eq)))  // --no-align=false used to turn alignment off
+        if (kFlags.count(s.substr(0, eq)))  // --no-align=false must not turn alignment off
           throw std::invalid_argument("--" + s.substr(0, eq) + " is a flag and takes no value, found '" + argv[i] + "'");
         a.opts.emplace(s.substr(0, eq), s.substr(eq + 1));
       } else if (kFlags.count(s)) {

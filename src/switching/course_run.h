@@ -20,11 +20,9 @@ struct Route {
 
 struct CourseRunConfig {
   /// [m] LevelPolicyConfig::small_gap_max. Medium only for gaps it crosses at any speed: the
-  /// validation has it pass 3 and 4 cm and stick in 4.5 cm gaps at 2.8 cm/s (4 cm only since its
-  /// chassis box reaches 4 mm above the ground, 2026-12-01; kept at 32 mm, the value the switching
-  /// results were measured with). At the driver's 17 cm/s it crossed this course's 40 mm gap by
-  /// hopping the far edge, until the treels' creep softened that impact (one run in 30 then stuck
-  /// there). The policy samples every 5 mm, so 32 mm separates the 30 mm gap from the 40 mm one.
+  /// validation has it pass 3 and 4 cm and stick in 4.5 cm gaps at 2.8 cm/s (32 mm is the value
+  /// the switching results were measured with). At the driver's 17 cm/s it can stick in this
+  /// course's 40 mm gap (one run in 30 with the treels' creep). The policy samples every 5 mm, so 32 mm separates the 30 mm gap from the 40 mm one.
   double small_gap_max = 0.032;
   /// [m] The policy runs in-process every 0.2 s, without latency: it must see the gripper tip
   /// (9 cm) plus the 3.4 cm driven between two evaluations at 17 cm/s ahead; 0.14 m leaves a

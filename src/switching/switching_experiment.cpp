@@ -145,7 +145,7 @@ int main(int argc, char** argv) {
       return a == "--help" ? 0 : 2;
     }
   }
-  // Before any run: an unknown mode found in the fork loop used to leave the modes before it running.
+  // Before any run: an unknown mode found in the fork loop would leave the modes before it running.
   const auto& levels = sbot::modelLevels();
   for (const auto& mode : o.modes) {
     if (mode == "switching" || std::find(levels.begin(), levels.end(), mode) != levels.end()) continue;

@@ -173,7 +173,7 @@ void applyStudyKnobs(WorldConfig& c) {
     if (c.solver != "quickstep" && c.solver != "exact")
       throw ConfigError("$SBOT_VALIDATE_SOLVER", "", "expected 'quickstep' or 'exact', found '" + c.solver + "'");
   }
-  // "1" welds, "0" or "" does not (it used to weld whenever the variable was set, even to 0).
+  // "1" welds, "0" or "" does not (set to 0, the variable does not weld).
   if (const char* e = std::getenv("SBOT_VALIDATE_WELD")) {
     const std::string v = e;
     if (v != "0" && v != "1" && !v.empty())
@@ -409,8 +409,9 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial, const
     // Toppled (over backwards): over, or tilted more than 75 deg off the normal of the surface
     // under its base, ramp or floor (a robot on the ramp leans back at most its own tipping angle;
     // one with its rear on the floor at the foot and its front up the face stands at 56-62 deg).
-    // Until 2026-11-27 the floor counted only from 100 deg off vertical, and a Medium that reared
-    // onto its tail at the foot of the 1.0 rad ramp (86 deg) and fell on its side was "slide back".
+    // Counted only from 100 deg off vertical, a Medium that rears onto its tail at the foot of the
+    // 1.0 rad ramp (86 deg) and falls on its side would be "slide back"
+    // (gtest ValidationLabels.ARobotThatRearsOverAtTheRampsFootHasToppled).
     const Vec3 up = upOf(r);
     const Vec3 under = r.basePose().position.x() > 0 ? normal : Vec3(Vec3::UnitZ());
     if (angleBetween(up, Vec3::UnitZ()) > 100 * M_PI / 180 || angleBetween(up, under) > 75 * M_PI / 180) {
@@ -476,9 +477,9 @@ Outcome downhillTrial(const std::string& level, double angle_rad, int trial, con
   const Vec3 ramp_normal(std::sin(angle_rad), 0, std::cos(angle_rad));  // the ramp falls toward +x
   runFor(w, t.seconds, [&] {
     // Toppled forward: over, or tilted more than 45 deg off the normal of the surface under its
-    // base (plateau, ramp, floor), i.e. pitched onto its nose or gripper (Table 4.3's rule). Until
-    // 2026-11-26 only "over" (100 deg) counted, and a Detailed robot that pitched 84 deg onto its
-    // gripper at 0.5 rad, slid down on it and fell back was a "pass".
+    // base (plateau, ramp, floor), i.e. pitched onto its nose or gripper (Table 4.3's rule). With
+    // only "over" (100 deg), a Detailed robot that pitches 84 deg onto its gripper at 0.5 rad,
+    // slides down on it and falls back would be a "pass".
     const double x = r.basePose().position.x();
     const Vec3 up = upOf(r);
     const double tilt = angleBetween(up, Vec3::UnitZ());
@@ -511,13 +512,13 @@ Outcome roughTrial(const std::string& level, double hr_cm, int trial, const std:
   c.terrain.size_x = c.terrain.size_y = 5.0 * s;  // 4.2.2: the Fast model's terrain is halved
   // HR in cm: the seed's simulator worked in CGS units (Tables 2.2-2.13: cm, dyne, dyne cm), and
   // its labels (HR 1 "almost flat" ... 32 "very rough") fit centimetres: on the default image HR 32 cm
-  // has slopes of 10 deg on average and up to 40, HR 32 mm nothing over 5 deg (until 2026-11-25 HR
-  // was read in mm, and every level kept its course at every HR once no run drove off the map).
+  // has slopes of 10 deg on average and up to 40, HR 32 mm nothing over 5 deg (read in mm, every
+  // level would keep its course at every HR).
   c.terrain.height_range = hr_cm / 100.0 * s;
   World w(c);
   // A random heading, then a random start from which the whole ideal path (1.52 m, the same for the
   // half-size Fast on its halved terrain) stays 15 cm inside the height field: there is no ground
-  // beyond its edge (before 2026-11-25 starts were drawn from +-1.5 m, and some runs drove off it).
+  // beyond its edge (from starts drawn over +-1.5 m some runs would drive off it).
   constexpr double kPath = 0.1524 * 10.0, kEdgeMargin = 0.15;  // [m]
   const double yaw = j.uniform(-M_PI, M_PI);
   const double inner = 0.5 * c.terrain.size_x - kEdgeMargin;

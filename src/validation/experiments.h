@@ -36,7 +36,7 @@ constexpr double kToppledTilt = 45 * 3.14159265358979323846 / 180;  // [rad]
 /// Gap and step passes: the robot is on its tracks at the end, tilted less than this.
 constexpr double kUprightTilt = 20 * 3.14159265358979323846 / 180;  // [rad]
 
-/// The solver study knobs every validation world honours (README "Solver"):
+/// The solver study knobs every validation world honours (docs/validation.md "Solver"):
 /// $SBOT_VALIDATE_ITERATIONS (quickstep iterations, overriding the levels' own), $SBOT_VALIDATE_SOLVER
 /// (quickstep | exact) and $SBOT_VALIDATE_WELD (the opt-in turret weld).
 /// Print the first robot's state every 0.1 s of simulated time while the experiments run (the

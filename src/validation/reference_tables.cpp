@@ -95,7 +95,7 @@ class Fields {
     if (required && t.empty()) fail_(where_ + ": field '" + k + "' is empty");
     return t;
   }
-  /// A number; an empty text is not one (it used to read as the field's absence: `param: ""` ran a
+  /// A number; an empty text is not one (read as the field's absence, `param: ""` would run a
   /// 0 m gap).
   double number(const std::string& k, bool required, double fallback = 0) {
     if (!has(k)) return required ? (text(k, true), 0.0) : fallback;

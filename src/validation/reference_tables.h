@@ -1,7 +1,7 @@
 // The tables sbot_validate compares the model with, as data: which experiment runs in each cell, on
 // which level and with which parameter, and what the reference (the hardware, the seed's simulator,
 // your own measurements) observed there. The seed's chapter 4 is config/validation/reference_tables.yaml;
-// `sbot_validate --tables FILE` runs any other file of the same form (README "Validation").
+// `sbot_validate --tables FILE` runs any other file of the same form (docs/validation.md).
 //
 // A file lists the report's sections in order: a table, or one of the built-in sections whose
 // experiments are not cells of one trial kind (the model facts, the two-robot rows, the RTM, the

@@ -151,8 +151,8 @@ class BagImporterTest(unittest.TestCase):
         self.assertIn("command", str(e.exception))
 
     def test_a_failed_append_leaves_the_dataset_as_it_was(self):
-        # An append that failed half-way (a full disk) used to leave dataset.yaml truncated, losing
-        # the index of the runs already there, and a CSV without its entry.
+        # An append that fails half-way (a full disk) must not leave dataset.yaml truncated, losing
+        # the index of the runs already there, nor a CSV without its entry.
         first = os.path.join(self.tmp, "first.bag")
         self.write_bag("straight_20", first)
         out = os.path.join(self.tmp, "appended")
@@ -238,7 +238,7 @@ class BagImporterTest(unittest.TestCase):
         self.assertFalse(os.path.exists(out))
 
     def test_append_adds_runs_of_the_same_robot_and_world_only(self):
-        # --append used to ignore --level and --world replaced the world of the runs already there.
+        # --append must not ignore --level, nor let --world replace the world of the runs already there.
         first = os.path.join(self.tmp, "append_first.bag")
         self.write_bag("straight_20", first)
         out = os.path.join(self.tmp, "appended")

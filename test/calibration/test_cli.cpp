@@ -1,5 +1,5 @@
 // The sbot_calibrate command line: options a subcommand does not take are refused with a message that
-// names them (a misspelt --effects used to be ignored, so `compare --effect F` compared the nominal
+// names them (ignored, a misspelt --effects would let `compare --effect F` compare the nominal
 // model), and so are bad values of the ones it does take.
 #include <gtest/gtest.h>
 
@@ -52,7 +52,7 @@ TEST(Cli, AnOptionTheSubcommandDoesNotTakeIsRefusedByName) {
   const Outcome d = run("diagnose " + kExample + " --treshold 5");
   EXPECT_EQ(d.status, 1) << d.output;
   EXPECT_NE(d.output.find("unknown option --treshold for 'diagnose'"), std::string::npos) << d.output;
-  // Last on the line, a misspelt option is named as such (it used to "need a value").
+  // Last on the line, a misspelt option is named as such (not as one that "needs a value").
   const Outcome last = run("compare " + kExample + " --no-plot");
   EXPECT_EQ(last.status, 1) << last.output;
   EXPECT_NE(last.output.find("unknown option --no-plot for 'compare'"), std::string::npos) << last.output;
@@ -65,7 +65,7 @@ TEST(Cli, ABadSolverIsRefusedByName) {
 }
 
 // An output place that cannot be written is refused before the work (a fit or a diagnosis runs for
-// minutes): compare and fit used to compute, then print "report: DIR/report.md" or lose the fitted
+// minutes): compare and fit must not compute, then print "report: DIR/report.md" or lose the fitted
 // effects file, with exit status 0.
 TEST(Cli, AnOutputPlaceThatCannotBeWrittenIsRefusedBeforeTheWork) {
   const std::string dir = testing::TempDir() + "cli_out/";
@@ -83,7 +83,7 @@ TEST(Cli, AnOutputPlaceThatCannotBeWrittenIsRefusedBeforeTheWork) {
   refused(run("generate --out " + dir + "plain"), "--out: cannot create directory '" + dir + "plain'");
 }
 
-// The plot script is started without a shell: an output folder with a quote in its name used to
+// The plot script is started without a shell: an output folder with a quote in its name must not
 // end the quoting and run the rest as a command. --no-plots links no plot that is not drawn.
 TEST(Cli, TheOutputFolderIsNotShellTextAndUndrawnPlotsAreNotLinked) {
   const std::string base = testing::TempDir() + "cli_quote/";
@@ -102,8 +102,8 @@ TEST(Cli, TheOutputFolderIsNotShellTextAndUndrawnPlotsAreNotLinked) {
   EXPECT_NE(::stat((out + "/plots/parity.png").c_str(), &st), 0) << "the earlier run's plot is still there";
 }
 
-// fit --effect ir_reflectance used to run 0 iterations on no parameter and write `params: {}`: its
-// parameters are per surface. They now come from the dataset's obstacles (as in diagnose); without
+// fit --effect ir_reflectance must not run 0 iterations on no parameter and write `params: {}`: its
+// parameters are per surface. They come from the dataset's obstacles (as in diagnose); without
 // any, the refusal says how to name the surfaces.
 TEST(Cli, APerSurfaceEffectIsFittedOnTheDatasetsSurfacesOrRefused) {
   const std::string dir = freshDir("cli_surfaces");
@@ -145,8 +145,8 @@ TEST(Cli, AFitStoppedByItsIterationLimitGivesNoInterval) {
   EXPECT_TRUE(contains(bad.output, "--max-iterations")) << bad.output;
 }
 
-// The error a fit ends with is the error compare finds with the file it wrote: the file used to
-// hold 8 digits, and the replay is chaotic enough that they moved it (fit 2.3969, compare 2.4041).
+// The error a fit ends with is the error compare finds with the file it wrote: with 8 digits in the
+// file the replay is chaotic enough that they move it (fit 2.3969, compare 2.4041).
 TEST(Cli, WhatAFitReportsIsWhatCompareOfItsFileReports) {
   const std::string dir = freshDir("cli_fit_compare");
   const Outcome fit = run("fit " + kExample + " --effect latency --effect track_width --max-iterations 1 --quiet --out " +
@@ -163,8 +163,8 @@ TEST(Cli, WhatAFitReportsIsWhatCompareOfItsFileReports) {
       << fit.output << "\n" << compare.output;
 }
 
-// An effect on channels the dataset does not measure used to be "fitted" (exponent = 0 +- 1e+06)
-// or screened without a word.
+// An effect on channels the dataset does not measure is not "fitted" (exponent = 0 +- 1e+06)
+// nor screened without a word.
 TEST(Cli, AnEffectOnChannelsTheDatasetDoesNotMeasureIsRefusedOrNoted) {
   const std::string dir = freshDir("cli_channels");
   const Outcome fit = run("fit " + kExample + " --effect ir_incidence --quiet --out " + dir + "f.yaml");
@@ -312,8 +312,8 @@ TEST(Cli, FitAndDiagnoseOutputsAreTriedBeforeTheWorkAndARefusedRunCreatesNoFolde
   EXPECT_FALSE(exists(dir + "made")) << "the refused run created the folder of its --write-effects";
 }
 
-// Outside probe, 2026-12-02: `fit --out DATASET/dataset.yaml` replaced the dataset with an effects
-// file, `diagnose --write-effects` a run's CSV, and `--no-align=false` turned alignment off.
+// `fit --out DATASET/dataset.yaml` must not replace the dataset with an effects file, nor
+// `diagnose --write-effects` a run's CSV, nor `--no-align=false` turn alignment off.
 TEST(Cli, TheDatasetsOwnFilesAreNotOverwrittenAndFlagsTakeNoValue) {
   const std::string dir = freshDir("cli_own_files");
   std::system(("cp -r " + kIrPoints + " " + dir + "ds").c_str());

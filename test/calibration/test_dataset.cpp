@@ -149,13 +149,13 @@ TEST(Dataset, NaNAndGarbageCells) {
   EXPECT_EQ(e.column(), 4);
   e = errorOf(makeDataset("range", "t,cmd_left,cmd_right,x\n0,200,1,0\n"));
   EXPECT_EQ(e.columnName(), "cmd_left");
-  // Read as 20 and as 20.5 before (an outside probe, 2026-11-29): a NUL byte inside a cell, and a
-  // command between API units, which setSpeed cannot have been given.
+  // Not to be read as 20 and as 20.5: a NUL byte inside a cell, and a command between API units,
+  // which setSpeed cannot have been given.
   e = errorOf(makeDataset("nul", std::string("t,cmd_left,cmd_right,x\n0,20\0,1,0\n", 33)));
   EXPECT_EQ(e.line(), 2);
   EXPECT_NE(std::string(e.what()).find("straight.csv:2: not a text CSV file: byte 5 of the line is 0x00"), std::string::npos)
       << e.what();
-  // A binary file was reported as an unknown column named by its raw bytes (2026-12-02).
+  // A binary file is refused as not text (not as an unknown column named by its raw bytes).
   std::string binary = "\x1f\x8b\x08";  // a gzip header
   for (int i = 0; i < 200; ++i) binary += static_cast<char>((i * 37) % 256);
   e = errorOf(makeDataset("binary", binary));
@@ -233,8 +233,8 @@ TEST(Dataset, BadYaml) {
   EXPECT_THROW(loadDataset("/nonexistent/dataset"), DatasetError);
 }
 
-// Input that used to crash a replay, run it for hours or turn into wrong numbers (an outside
-// probe of 2026-11-28): each is refused naming the file, line and column.
+// Input that would crash a replay, run it for hours or turn into wrong numbers: each is refused
+// naming the file, line and column.
 TEST(Dataset, ValuesNoReplayCanUseAreRefusedByPlace) {
   const std::string head = "t,cmd_left,cmd_right,x,ir0\n0,1,1,0,\n";
   struct Case {
@@ -312,7 +312,7 @@ TEST(Dataset, RunNamesStartPosesAndSegmentsAreChecked) {
   ::mkdir((sub + "/day1").c_str(), 0755);
   write(sub + "/day1/straight.csv", csv);
   EXPECT_EQ(loadDataset(sub).runs.at(0).name, "straight");
-  // A start pose without its yaw used to start at yaw 0.
+  // A start pose without its yaw is refused (not started at yaw 0).
   e = errorOf(makeDataset("pose", csv, withRun("  - {name: s, file: straight.csv, initial_pose: {x: 0, y: 0}}\n")));
   EXPECT_NE(std::string(e.what()).find("runs[0].initial_pose.yaw"), std::string::npos) << e.what();
   // A value of the wrong type names the file and line (was yaml-cpp's bare "bad conversion").
@@ -330,8 +330,8 @@ TEST(Dataset, RunNamesStartPosesAndSegmentsAreChecked) {
   e = errorOf(makeDataset("segment", csv, "align_segment: 0.05\n" + std::string(kYaml)));
   EXPECT_NE(std::string(e.what()).find("at least 1 s"), std::string::npos) << e.what();
   EXPECT_NO_THROW(loadDataset(makeDataset("segment_ok", csv, "align_segment: 0\n" + std::string(kYaml))));
-  // Outside probe, 2026-12-02: a start the world cannot place was named by the first replay only,
-  // without file or field; a start time of 1e300 s drained the battery model at once.
+  // A start the world cannot place is named here, with file and field, not by the first replay;
+  // a start time of 1e300 s would drain the battery model at once.
   e = errorOf(makeDataset("far", csv, withRun("  - {name: s, file: straight.csv, initial_pose: {x: 1e9, y: 0, yaw: 0}}\n")));
   EXPECT_NE(std::string(e.what()).find("runs[0].initial_pose.x': value 1e+09 outside the range of x"), std::string::npos) << e.what();
   e = errorOf(makeDataset("spun", csv, withRun("  - {name: s, file: straight.csv, initial_pose: {x: 0, y: 0, yaw: 1e6}}\n")));
@@ -341,8 +341,8 @@ TEST(Dataset, RunNamesStartPosesAndSegmentsAreChecked) {
   EXPECT_NE(std::string(e.what()).find("runs[0].start_time"), std::string::npos) << e.what();
 }
 
-// A robot measured inside a wall or below the floor was replayed without a word (outside probe,
-// 2026-12-02): a drive start thrown out by the contacts, IR read from inside the wall.
+// A robot measured inside a wall or below the floor is named, not replayed without a word (a
+// drive start thrown out by the contacts, IR read from inside the wall).
 TEST(Dataset, PlacesNoRobotCanHaveBeenMeasuredAtAreNamed) {
   const std::string drive_csv = "t,cmd_left,cmd_right,x\n0,1,1,0\n";
   const auto withRun = [](const std::string& run) {

@@ -127,7 +127,7 @@ TEST(ReplaySensitivity, NamesTheRunsEvenTheTrueModelCannotReproduce) {
 }
 
 // The start is nudged both ways and the worse side counts: a tip can lie on one side of the start
-// only (until 2026-11-29 only +1 sigma was tried, and a run tipping on the other side passed).
+// only (with +1 sigma alone a run tipping on the other side passes).
 TEST(ReplaySensitivity, TheWorseOfBothNudgesCounts) {
   GeneratorOptions g;
   g.level = "fast";
@@ -147,7 +147,7 @@ TEST(ReplaySensitivity, TheWorseOfBothNudgesCounts) {
     EXPECT_DOUBLE_EQ(both[k].nrms, std::max(plus[k].nrms, minus[k].nrms)) << name;
     most_above_plus = std::max(most_above_plus, both[k].nrms - plus[k].nrms);
   }
-  // Here arc_left: +54 / -85 (2026-11-29).
+  // Here arc_left: +54 / -85.
   EXPECT_GT(most_above_plus, 1.0) << "in some run the minus side moves the prediction by a noise more than the plus side";
 }
 
@@ -211,8 +211,8 @@ TEST(ReplayableRuns, AreLeftOutAndReadmittedOnceASolvedModelReplaysThem) {
 }
 
 // The seed's published sensor response points (Appendix A; datasets/make_seed_datasets.py places the
-// robot from the Medium URDF) are reproduced within their noise. This failed unnoticed once when the
-// script hard-coded a ground sensor depth the URDF no longer had (nRMS 7).
+// robot from the Medium URDF) are reproduced within their noise (a ground sensor depth that is not
+// the URDF's gives nRMS 7).
 TEST(SeedDatasets, SensorResponsePointsAreReproduced) {
   for (const std::string name : {"seed_ir_response", "seed_ground_response"}) {
     const Dataset ds = loadDataset(std::string(SWARMBOT3D_SOURCE_DIR) + "/datasets/" + name);
@@ -224,8 +224,8 @@ TEST(SeedDatasets, SensorResponsePointsAreReproduced) {
 
 // The seed's traction measurement (a passive s-bot pulled with a force ramped 0 -> 2 N does not move
 // below 1.2 N) is reproduced by the model with the exact solver: it holds within the tracker noise
-// and breaks away above 1.2 N. With quickstep it creeps and turns (docs/calibration.md, README
-// "Known flaw: yaw drift"); this test pins the physics, not that solver artefact.
+// and breaks away above 1.2 N. With quickstep it creeps and turns (docs/calibration.md, docs/model.md
+// "Yaw drift under quickstep"); this test pins the physics, not that solver artefact.
 TEST(SeedDatasets, TractionIsReproducedWithTheExactSolver) {
   Dataset ds = loadDataset(std::string(SWARMBOT3D_SOURCE_DIR) + "/datasets/seed_traction");
   ds.world.solver = "exact";

@@ -6,7 +6,7 @@ twice with lockstep:=true, as fast as possible, each with its own ROS master on 
 /swarm/graph, and checks that the robots' positions agree at every common stamp (to 1e-9 m) and that
 the robots moved. The same for swarm.launch (5 Simple s-bots, one random_walk node each, recorded
 by the launch's own rosbag at 10 Hz). Without lock-step the controllers answer a varying number of steps late and the
-two runs differ (see the README, "Lock-step"). A third run freezes one controller (SIGSTOP, as a
+two runs differ (see docs/ros_api.md, "Lock-step"). A third run freezes one controller (SIGSTOP, as a
 hung controller or a debugger would) in the middle: the simulator drops it after ~lockstep_timeout
 and finishes the run. (A controller that dies outright unsubscribes, so nothing is held for it.)
 """

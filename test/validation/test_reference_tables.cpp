@@ -178,7 +178,7 @@ TEST(ReferenceTables, MalformedFilesAreRefusedWithTheEntryAndTheProblem) {
         "two cells are both 'lab1 30 mm'"},
       {with("        - {param: 0.030, measured: pass}\n", "        - {param: 0.030, measured: {accepts: pass, text: \"a|b\"}}\n"),
         "holds a '|' or a line break, which would split the report's table"},
-      // Outside probe, 2026-11-28:
+      // Values a report cannot use:
       {with("param: 0.060", "param: \"\""), "cell 1: field 'param' expects a finite number, found ''"},  // was a 0 m gap
       {with("measured: pass}", "measured: {accepts: \"\", text: pass}}"), "field 'accepts' is empty"},
       {with("measured: pass}", "measured: \"pass|\"}"), "every alternative between '|' must be a label"},
@@ -195,7 +195,7 @@ TEST(ReferenceTables, MalformedFilesAreRefusedWithTheEntryAndTheProblem) {
         "cell 2: field 'track_mu' expects a friction coefficient in [1e-6, 100] or lab_floor, found '-0.5'"},
       {with("level: medium\n", "level: medium\n      track_mu: lab floor\n"), "found 'lab floor'"},
       {with("decimals: 1}", "decimals: 9}"), "table 'lab1', value: decimals expects a whole number from 0 to 6, found '9'"},
-      // -1 is how the loader marks "not given"; written in a file it was taken as that (2026-11-29).
+      // -1 is how the loader marks "not given"; written in a file it must not be taken as that.
       {with("decimals: 1}", "decimals: -1}"), "table 'lab1', value: decimals expects a whole number from 0 to 6, found '-1'"},
       {with("references: [measured]", "references: [measured, measured]"), "'references' names the column 'measured' twice"},
       {with("required: true", "required: maybe"), "field 'required' expects true or false, found 'maybe'"},
@@ -206,7 +206,7 @@ TEST(ReferenceTables, MalformedFilesAreRefusedWithTheEntryAndTheProblem) {
       {with("report:\n", "report:\n  - table: {id: lab1, title: x, references: [a], experiment: gap, level: fast, "
                           "cells: [{param: 0.03, a: pass}]}\n"),
         "'lab1' appears twice in the report"},
-      // Outside probe, 2026-12-02: a slope cell in a gap table read "25000 mm", a gap "0.03 deg".
+      // A slope cell in a gap table would read "25000 mm", a gap "0.03 deg".
       {with("{param: 0.035, level: basic, measured: pass}", "{param: 25, experiment: slope, measured: full}"),
         "cell 2: slope's parameter is a slope in deg, which the table's param format shows as x1000 mm"},
       {with("unit: mm, scale: 1000", "unit: deg, scale: 1"), "gap's parameter is a gap width in m, which the table's param format shows as x1 deg"},

@@ -41,7 +41,7 @@ TEST(RunParallel, AJobThatThrowsIsThatJobsErrorAlone) {
 TEST(RunParallel, AWorkerThatDiesCostsOnlyTheJobItWasRunning) {
   testing::internal::CaptureStderr();
   // Two workers: jobs 0, 2, 4 and 1, 3, 5. The first dies in job 2 (as an ODE assertion aborts); job
-  // 4, which it had not reached, runs again in a fresh worker (it used to be "error" too).
+  // 4, which it had not reached, runs again in a fresh worker (it is not "error").
   const auto r = v::runParallel(6, 2, [](int i) {
     if (i == 2) std::raise(SIGKILL);
     return v::Outcome{"ok", static_cast<double>(i)};

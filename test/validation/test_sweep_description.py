@@ -40,7 +40,7 @@ class SweepDescription(unittest.TestCase):
 
     def test_a_variant_that_changes_no_generated_file_is_named_and_not_run(self):
         # Entries under `shared:` reach the levels through YAML aliases and merge keys at load time:
-        # setting one afterwards changes no level (a 2026-11-26 creep sweep ran three identical models).
+        # setting one afterwards changes no level (a sweep over one would run identical models).
         keep = tempfile.mkdtemp(prefix="sweep_test_")
         r = sweep("--grid", "shared.treels_api.creep_stiffness=3.0,5.6", "--only", "4.2", "--trials", "1",
                   "--keep", keep)

@@ -105,8 +105,8 @@ TEST(TerrainScenarios, ATrialsWorldWrittenAsAScenarioReadsBackExactly) {
 }
 
 // The half-size Fast robot meets its terrain halved (seed 4.2.2): a cell's gap width and step height
-// are full-size values, halved in the Fast trial's world (steps kept their full height until
-// 2026-11-28, a 30 mm Fast step cell being a step taller than the half-size robot's wheels).
+// are full-size values, halved in the Fast trial's world (at full height a 30 mm Fast step cell
+// would be a step taller than the half-size robot's wheels).
 TEST(TerrainScenarios, TheFastRobotsGapsAndStepsAreHalved) {
   auto box = [](const validation::TrialWorld& t, const std::string& name) {
     for (const BoxObstacle& b : t.world.terrain.boxes)

@@ -1,6 +1,6 @@
 // The headless tools' options (sbot_validate, switching_experiment, two_sbots; sbot_sim/tools/cli_args.h):
 // a missing value, or a value that is not a number in range, is refused with exit status 2 and a
-// message that names the option and what was found (atoi/atof used to turn "abc" into a silent 0 runs
+// message that names the option and what was found (atoi/atof would turn "abc" into a silent 0 runs
 // or trials); and the machine they name beside their figures (sbot_sim/tools/machine.h).
 #include <gtest/gtest.h>
 #include <fcntl.h>
@@ -56,7 +56,7 @@ TEST(ToolsCli, NonNumbersAndOutOfRangeValuesAreRefusedByName) {
   expectRefused("sbot_validate", "--trial step huge 0.01", "sbot_validate: --trial step huge: unknown model level 'huge'");  // aborted
 }
 
-// sbot_bench (package sbot_sim) reads the same way; it used to run rows of 0 robots or 0 seconds.
+// sbot_bench (package sbot_sim) reads the same way, and runs no rows of 0 robots or 0 seconds.
 TEST(ToolsCli, BenchRefusesWhatItCannotRun) {
   const auto refused = [](const std::string& args, const std::string& message) {
     const Outcome o = sbot_test::runProcess(std::string(SBOT_BENCH_BIN) + " " + args);
@@ -163,8 +163,8 @@ TEST(ToolsCli, BenchSensorRowsReadLitSwarms) {
   EXPECT_EQ(blobs(one.output), 0.0) << one.output;
 }
 
-// The last option without its value (two_sbots used to read it as "": --level "" then failed later
-// with an unrelated message).
+// The last option without its value (read as "", --level "" would fail later with an unrelated
+// message).
 TEST(ToolsCli, AnOptionWithoutItsValueIsRefusedByName) {
   expectRefused("sbot_validate", "--out", "sbot_validate: --out needs a value");
   expectRefused("sbot_validate", "--trial step detailed", "sbot_validate: --trial needs PARAM after KIND LEVEL");
@@ -173,8 +173,8 @@ TEST(ToolsCli, AnOptionWithoutItsValueIsRefusedByName) {
   expectRefused("two_sbots", "--level", "two_sbots: --level needs a value");
 }
 
-// An unknown switching mode is refused before any mode's run starts: it used to be found in the loop
-// that starts them, after "detailed" had been started, and without the tool's name.
+// An unknown switching mode is refused before any mode's run starts, naming the tool (not found in
+// the loop that starts them, after "detailed" had been started).
 TEST(ToolsCli, AnUnknownModeIsRefusedBeforeAnyRun) {
   expectRefused("switching_experiment", "--runs 1 --out " + testing::TempDir() + "cli_modes --modes detailed,bogus",
                 "switching_experiment: --modes: unknown mode 'bogus' (modes: switching, fast, simple, basic, medium, detailed)");
@@ -182,8 +182,8 @@ TEST(ToolsCli, AnUnknownModeIsRefusedBeforeAnyRun) {
                 "switching_experiment: --modes: unknown mode '' (modes:");
 }
 
-// The solver and friction study knobs (src/validation/README.md "Solver") are read from the environment by both
-// tools; a value they cannot use stops them before any trial (an unparsable iteration count used to
+// The solver and friction study knobs (docs/validation.md "Solver") are read from the environment by both
+// tools; a value they cannot use stops them before any trial (an unparsable iteration count must not
 // become 0 iterations through atoi).
 TEST(ToolsCli, UnusableStudyKnobsAreRefusedByName) {
   // variable=value, and the message the tool must stop with (exit status 2)
@@ -217,8 +217,8 @@ TEST(ToolsCli, UnusableStudyKnobsAreRefusedByName) {
   EXPECT_NE(o.output.find("step detailed 0.01: pass"), std::string::npos) << o.output;
 }
 
-// The weld knob is a switch: 0 is the default (it used to weld whenever the variable was set), 1
-// welds. Medium on the 0.7 rad ramp is a trial the weld changes (src/validation/README.md, "Turret weld").
+// The weld knob is a switch: 0 is the default (set to 0 it does not weld), 1 welds. Medium on the
+// 0.7 rad ramp is a trial the weld changes (docs/model.md, "Yaw drift under quickstep").
 TEST(ToolsCli, TheWeldKnobZeroIsTheDefaultAndOneWelds) {
   const std::string trial = std::string(SWARMBOT3D_BIN_DIR) + "/sbot_validate --trial uphill medium 0.7";
   const Outcome unset = sbot_test::runProcess("env -u SBOT_VALIDATE_WELD " + trial);
@@ -242,7 +242,7 @@ TEST(ToolsCli, IndexRunsAnotherTrialOfTheCell) {
   EXPECT_NE(second.output, first.output);
 }
 
-// Inputs that used to give a report anyway: a misspelt --only section (an empty report, status 0)
+// Inputs that must not give a report anyway: a misspelt --only section (an empty report, status 0)
 // and an unreadable height map (288 failed runs shown as "0.00 +- 0.00" in Figure 4.4).
 TEST(ToolsCli, UnknownSectionsAndUnreadableHeightMapsAreRefusedBeforeAnyRun) {
   const std::string out = "--out " + testing::TempDir() + "cli_refused ";
@@ -293,10 +293,10 @@ TEST(ToolsCli, AnotherReferenceTableRunsAndDecidesTheExitStatus) {
                 "--only: unknown section '4.5' (in " + dir + "ok.yaml: lab1)");
 }
 
-// Findings of an outside probe (2026-11-28): a 0 mm step stopped ODE with an assertion (and cost
-// the worker's other cells), options only --trial reads were ignored by a report, an empty --only
-// ran the whole suite, the seed's reasons "explained" cells of another tables file, and a reason
-// whose key names no cell was silently never shown.
+// Inputs to refuse or name: a 0 mm step would stop ODE with an assertion (and cost the worker's
+// other cells), options only --trial reads would be ignored by a report, an empty --only would run
+// the whole suite, the seed's reasons would "explain" cells of another tables file, and a reason
+// whose key names no cell would silently never be shown.
 TEST(ToolsCli, ProbedTablesAndOptionsAreRunOrRefusedAsTheySay) {
   const std::string dir = testing::TempDir() + "cli_probe/";
   std::system(("mkdir -p " + dir).c_str());
@@ -332,7 +332,7 @@ TEST(ToolsCli, ProbedTablesAndOptionsAreRunOrRefusedAsTheySay) {
 // A table's cells can drive at another speed than the seed's 2.8 cm/s (speed_units): the Medium is
 // stuck in a 4.5 cm gap at 2.8 cm/s and crosses it on its momentum at 16.8 cm/s (the seed's reason for
 // driving slowly, 4.2.3); the report then shows each cell's speed, and the variants that tell the two
-// rows apart (without a variant_header they used to be hidden).
+// rows apart (also without a variant_header).
 TEST(ToolsCli, ATableCellDrivesAtItsOwnSpeed) {
   const std::string dir = testing::TempDir() + "cli_speed/";
   std::system(("mkdir -p " + dir).c_str());
@@ -443,8 +443,7 @@ std::string twoTables(const std::string& dir, int detailed_cells) {
   return dir + "tables.yaml";
 }
 
-// A run stopped part-way (Ctrl-C, a killed job) used to lose every finished section: the report was
-// written only at the end. The report so far is kept as report.partial.md, section by section, and
+// A run stopped part-way (Ctrl-C, a killed job) keeps every finished section: the report so far is kept as report.partial.md, section by section, and
 // the finished run replaces it by report.md.
 TEST(ToolsCli, AStoppedRunKeepsTheSectionsItFinished) {
   const std::string dir = testing::TempDir() + "cli_stopped/";
@@ -562,8 +561,8 @@ TEST(ToolsCli, FigureFourFourHasItsTablePlotAndTheSeedsReading) {
   EXPECT_EQ(o.output.find("not explained yet"), std::string::npos) << o.output;
 }
 
-// Outside probe, 2026-12-02: with --only a required group's tally read "1/1" of its two cells, and
-// a file whose tables name no group gave exit status 0 without a word that nothing was compared.
+// With --only a required group's tally must not read "1/1" of its two cells, and a file whose
+// tables name no group must not give exit status 0 without a word that nothing was compared.
 TEST(ToolsCli, ATallySaysWhatOnlyLeftOutAndAnUntalliedReportSaysSo) {
   const std::string dir = testing::TempDir() + "cli_tally/";
   std::system(("mkdir -p " + dir).c_str());
@@ -584,9 +583,9 @@ TEST(ToolsCli, ATallySaysWhatOnlyLeftOutAndAnUntalliedReportSaysSo) {
   EXPECT_NE(o.output.find("warning: no cell is tallied"), std::string::npos) << o.output;
 }
 
-// Outside probe, 2026-12-02: what followed --trial's three values was ignored (report options too,
-// as --trials 3 with it ran one trial), an empty --scenario ran the trial instead of writing it, a
-// --scenario over a file of one's own replaced it, and an unknown option printed only the usage.
+// What follows --trial's three values is not ignored (report options too: --trials 3 with it would
+// run one trial), an empty --scenario is refused rather than running the trial, a --scenario over a
+// file of one's own does not replace it, and an unknown option is named, not just the usage.
 TEST(ToolsCli, ATrialTakesOnlyItsOwnOptionsAndKeepsOtherFiles) {
   expectRefused("sbot_validate", "--trial step detailed 0.01 extra", "--trial KIND LEVEL PARAM comes last; found 'extra' after it");
   expectRefused("sbot_validate", "--trials 3 --trial step detailed 0.01", "--trials makes a report; --trial runs one trial");
@@ -611,9 +610,9 @@ TEST(ToolsCli, AValidTrialRuns) {
 
 // --trace prints the robot's state every 0.1 s (pose, attitude, wheel load, track speeds, turret
 // angle, gripper tip height): here the Detailed model reversing into a 15 mm step
-// tips nose down toward its gripper (the hardware passes; 10 mm passes since the turret COM
-// calibration); the trial stops as a topple once it is 45 deg off the vertical
-// (it used to drive on standing on its gripper at 70-77 deg and count as a pass).
+// tips nose down toward its gripper (the hardware passes; 10 mm passes with the calibrated turret
+// COM); the trial stops as a topple once it is 45 deg off the vertical
+// (not driving on, standing on its gripper at 70-77 deg, to count as a pass).
 TEST(ToolsCli, TraceShowsTheRobotTippingOntoItsGripper) {
   const Outcome o = run("sbot_validate", "--trace --trial stepb detailed 0.015");
   EXPECT_EQ(o.status, 0) << o.output;

@@ -152,8 +152,7 @@ TEST(ValidationDownhill, DetailedManagesAGentleRampAndTopplesForwardOnSteeperOne
   // The Detailed model tips over its front statically at ~26-28.5 deg (the test above): it manages
   // 0.3 rad (17 deg) and topples at 0.8 rad (46 deg). At 0.5 rad (28.6 deg) it pitches 84 deg onto
   // its held gripper and slides down on it, which the trial counts as the topple it is (tilted
-  // > 45 deg off the ramp's normal; before 2026-11-26 only > 100 deg off vertical counted, and this
-  // was a "pass").
+  // > 45 deg off the ramp's normal; counting only > 100 deg off vertical, this would be a "pass").
   const std::vector<double> angles{0.3, 0.5, 0.8};
   const auto r = v::runParallel(3, 2, [&](int i) { return v::downhillTrial("detailed", angles[i], 0); });
   EXPECT_EQ(r[0].label, "pass") << "0.3 rad";
@@ -163,9 +162,9 @@ TEST(ValidationDownhill, DetailedManagesAGentleRampAndTopplesForwardOnSteeperOne
 
 TEST(ValidationLabels, ARobotThatRearsOverAtTheRampsFootHasToppled) {
   // Table 4.6: a Medium at 0.9 and 1.0 rad gets its front up the face with its rear spheres wedged
-  // in the ramp's foot, rears onto its tail (86-90 deg) and falls on its side. Until 2026-11-27 the
-  // rule counted a robot on the floor as toppled only from 100 deg off vertical, and these trials
-  // (both "slide back" then) looked like the seed's slide back.
+  // in the ramp's foot, rears onto its tail (86-90 deg) and falls on its side. A rule counting a
+  // robot on the floor as toppled only from 100 deg off vertical would label these trials "slide
+  // back", the seed's label.
   const std::vector<std::pair<double, int>> trials{{1.0, 0}, {0.9, 1}};
   const auto res = v::runParallel(static_cast<int>(trials.size()), 2,
                                   [&](int i) { return v::uphillTrial("medium", trials[i].first, trials[i].second); });

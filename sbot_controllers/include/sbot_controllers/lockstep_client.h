@@ -1,5 +1,5 @@
 // A controller node's side of the simulator's lock-step (simulator ~lockstep true; the protocol is
-// described in sbot_sim/src/node/lockstep_gate.h and the README, "Lock-step").
+// described in sbot_sim/src/node/lockstep_gate.h and docs/ros_api.md, "Lock-step").
 //
 // The simulator holds its clock while a controller has a message to read on the topic it said it
 // waits for, or while commands it said it sent are still in flight. A controller therefore calls

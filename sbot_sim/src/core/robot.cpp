@@ -269,7 +269,7 @@ void Robot::buildBodyDrive() {
   dJointAttach(drive_linear_, chassis, nullptr);
   dJointSetLMotorNumAxes(drive_linear_, 2);
   // rel 1: the axes stay fixed in the chassis, but ODE takes them in world coordinates, as the
-  // chassis lies now (given as (1, 0, 0), a robot spawned facing +y drove sideways along +x).
+  // chassis lies now (given as (1, 0, 0), a robot spawned facing +y would drive sideways along +x).
   const Quat q = bodyPose(chassis).orientation;
   const Vec3 forward = q * Vec3::UnitX(), left = q * Vec3::UnitY(), up = q * Vec3::UnitZ();
   dJointSetLMotorAxis(drive_linear_, 0, 1, forward.x(), forward.y(), forward.z());

@@ -71,8 +71,8 @@ const std::string kGround = "ground";
 /// the contact plane (axle x normal). On floors and ramps that is the heading; on a face the robot
 /// is pressed against, it is up the face. The heading's projection there is only a sideways
 /// remnant of the robot's yaw, and a pyramid turned by it let friction hold up to 1.4 mu N up the
-/// face (the box's diagonal; measured 2026-11-27 at a step's face at mu 0.5: 0.69 N up per 1 N
-/// pressed). Contacts on the robot's flanks (normal along the axle) keep the heading.
+/// face (the box's diagonal; at a step's face at mu 0.5: 0.69 N up per 1 N pressed, gtest
+/// TreelsFriction.APyramidOnAFaceAheadRunsUpTheFace). Contacts on the robot's flanks (normal along the axle) keep the heading.
 Vec3 rollingDirection(const Vec3& axle, const Vec3& normal, const Vec3& heading_in_plane) {
   const Vec3 roll = axle.cross(normal);
   if (roll.norm() < 0.5) return heading_in_plane;
@@ -597,8 +597,8 @@ void World::handlePair(dGeomID a, dGeomID b) {
   ContactContext ctx;
   ctx.robot_a = ia ? ia->robot : nullptr;
   ctx.robot_b = ib ? ib->robot : nullptr;
-  // Robot against robot: a sleeper that a standing (settling) robot touches stays asleep; two
-  // settling neighbours used to wake each other for ever (README, "Sleeping at rest").
+  // Robot against robot: a sleeper that a standing (settling) robot touches stays asleep, or two
+  // settling neighbours would wake each other for ever (docs/model.md, "Sleeping at rest").
   const Robot* held_back_sleeper = nullptr;
   if (ba && bb && ctx.robot_a && ctx.robot_b && ctx.robot_a != ctx.robot_b) {
     const bool awake_a = dBodyIsEnabled(ba), awake_b = dBodyIsEnabled(bb);

@@ -1,5 +1,5 @@
 // simulator_node: runs one scenario of the s-bot swarm simulator and exposes it to ROS.
-// Parameters, topics and services: see sim_ros_interface.h and the README.
+// Parameters, topics and services: see sim_ros_interface.h and docs/ros_api.md.
 #include <csignal>
 
 #include <ros/ros.h>

@@ -172,7 +172,7 @@ TEST(ActuatorGripper, JawsConnectToTheRingAfterClosing) {
   ASSERT_TRUE(ga.gripping());
   EXPECT_EQ(ga.gripped(), "sbot_1");
   EXPECT_LE(ga.getAperture(), 10) << "closed on the ring: the jaws stop at its thickness";
-  int widest = 0;  // and stay there while connected (they used to bounce open to 14 deg)
+  int widest = 0;  // and stay there while connected (not bounce open)
   for (int i = 0; i < 100; ++i) {
     w.step();
     ga.update(w.config().step);

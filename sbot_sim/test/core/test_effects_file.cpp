@@ -70,7 +70,7 @@ TEST(EffectsFile, ErrorsNameTheField) {
   EXPECT_EQ(fieldOf("effects: [{name: latency, params: {delay: 0.1}}, {name: latency, delay: 1}]"), "effects[1].delay");
   EXPECT_EQ(fieldOf("effects:\n  - name: latency\n    name: speed_scale\n"), "") << "a repeated key names the file";
   EXPECT_THROW(loadEffectsFile("/nonexistent/effects.yaml"), ConfigError);
-  // A folder read as an empty stream: "no effects" (an outside probe, 2026-11-29).
+  // A folder is not an effects file (read as a stream it would be empty: "no effects").
   try {
     loadEffectsFile("/tmp");
     ADD_FAILURE() << "a folder was read as an effects file";

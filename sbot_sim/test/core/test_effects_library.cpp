@@ -181,8 +181,7 @@ TEST(DriveEffects, DeadBandSwallowsSmallCommands) {
 TEST(DriveEffects, LagAndRampSlowTheAcceleration) {
   // Distance lost to the transient grows with the time constant / ramp time. (Not exactly v tau or
   // v t / 2: the nominal robot is itself slow to spin up its reflected rotor inertia, and the two
-  // transients overlap: a 0.3 s lag loses 1.4 cm of v tau = 5 cm, 2.8 cm with the 20 g wheels
-  // before 2026-12-01.)
+  // transients overlap: a 0.3 s lag loses 1.4 cm of v tau = 5 cm.)
   const double d0 = distance(drive({}, 60, 60, 2.5));
   auto loss = [&](const char* effect, const char* param, double v) {
     return d0 - distance(drive({{effect, {{param, v}}, {}, ""}}, 60, 60, 2.5));
@@ -226,7 +225,7 @@ TEST(DriveEffects, TorqueEffectsShowInTheTorqueReadings) {
 
 TEST(DriveEffects, AnisotropicTrackFrictionChangesSkidSteering) {
   // Mean over three seeds: quickstep on six wheels turns one 2 s spin by a few % more or less from
-  // seed to seed, and by as much for a lateral ratio of 0.9999 (2026-11-27: -4.08 to -4.50 rad).
+  // seed to seed, and by as much for a lateral ratio of 0.9999 (-4.08 to -4.50 rad).
   auto turned = [](double ratio) {
     std::vector<EffectConfig> effects;
     if (ratio != 1.0) effects.push_back({"track_friction_anisotropy", {{"lateral_ratio", ratio}}, {}, ""});

@@ -96,9 +96,8 @@ TEST(ModelSwitch, SwitchedRunFollowsTheUnswitchedTrajectory) {
   // Through every full-size level: straight ahead the levels agree within 2 cm after 0.8 m; on a
   // curve their turning differs (seed 4.3: "the detailed model is not very accurate in making
   // right angle turns": unswitched at (50, 35) for 6 s Simple, Basic and Medium turn 173-176-164
-  // deg, Detailed 92), still within 15 cm. Measured: 9.0 cm before the Detailed turret's COM was
-  // calibrated 1 cm further back on the hardware rows, 10.2 cm after, 13.1 cm since Basic and
-  // Medium share that COM (2026-11-27; Medium then turned 177 deg, now 164).
+  // deg, Detailed 92), still within 15 cm. Measured: 13.1 cm with the calibrated turret COM
+  // that Basic, Medium and Detailed share (Medium turns 164 deg).
   const std::vector<std::string> cycle{"medium", "detailed", "medium", "basic", "simple", "basic"};
   const auto ref = driveSwitching(50, 50, {});
   const auto sw = driveSwitching(50, 50, cycle);
@@ -137,8 +136,8 @@ TEST(ModelSwitch, LevelsRoundTrip) {
               r.basePose().orientation.angularDistance(p0.orientation) * 180 / M_PI,
               test::wrapAngle(r.basePose().yaw() - p0.yaw()) * 180 / M_PI);
   EXPECT_LT((r.basePose().position - p0.position).norm(), 0.005);
-  // Turned: quickstep's yaw drift while standing (README, "Yaw drift and the turret weld"): 2.1 s
-  // standing gave 1.4 deg, 1.8 deg since the Detailed turret's COM calibration.
+  // Turned: quickstep's yaw drift while standing (docs/model.md, "Yaw drift under quickstep"): 2.1 s
+  // standing gives 1.8 deg.
   EXPECT_LT(r.basePose().orientation.angularDistance(p0.orientation), 0.045);
 }
 

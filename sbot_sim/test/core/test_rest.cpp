@@ -23,8 +23,8 @@ double planarDistance(const Pose& a, const Pose& b) { return (a.position - b.pos
 
 class RestEveryLevel : public ::testing::TestWithParam<const char*> {};
 
-// Under quickstep a standing Simple slid 19 mm in 10 s, a Basic 14, a Medium 8 (README, "Creep at
-// rest"); asleep, it does not move at all.
+// Under quickstep, awake, a standing Simple slides 19 mm in 10 s, a Basic 14, a Medium 8
+// (docs/model.md, "Sleeping at rest"); asleep, it does not move at all.
 TEST_P(RestEveryLevel, AStandingRobotFallsAsleepAndStaysPut) {
   World w(flatWorld(3));
   Robot& r = w.addRobot(loadLevel(GetParam()), {0.1, -0.2, 2.5}, "sbot_0");
@@ -267,10 +267,10 @@ struct StandingFastPair {
 // A neighbour asleep 1.7 cm from a sleeper, woken by a pusher driving slower than
 // Robot::kStandingSpeed, is shoved into the sleeper, which must move as far as with sleep off. The
 // neighbour stands when the push starts (3 s since its last command, its bodies slow). Without
-// World::releaseHeldBackContacts it leaned on the sleeper as on a wall and pushed it 0.047 m
-// against 0.071 m; since Robot::standing asks for no move past the rest limits in 0.25 s, the
-// shoved neighbour no longer stands and this holds without the release too (README, "Neighbours
-// and groups"). (The two are Fast robots, 33 g: a Simple does not shove two of its own kind.)
+// World::releaseHeldBackContacts it would lean on the sleeper as on a wall (pushing it 0.047 m
+// against 0.071 m); with Robot::standing asking for no move past the rest limits in 0.25 s, the
+// shoved neighbour does not stand and this holds without the release too (docs/model.md,
+// "Sleeping at rest"). (The two are Fast robots, 33 g: a Simple does not shove two of its own kind.)
 TEST(Rest, ASleeperIsPushedThroughAStandingNeighbourThatADrivingRobotShoves) {
   const auto sleeperShift = [](bool sleep) {
     StandingFastPair pair(sleep, 0.19);

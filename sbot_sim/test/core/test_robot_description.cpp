@@ -186,10 +186,10 @@ TEST(RobotDescription, SensorExtrasMustBeFiniteAndRayCountsWhole) {
 }
 
 
-// An outside probe (2026-11-29): an `extra` value a module reads late aborted the node from inside
-// its sensor set-up (std::terminate), others were never read and any value passed, a window of
-// 1e7 s took the node past 24 GB, and a copied sidecar's level or material went unnoticed. Each is
-// now refused when the sidecar loads, naming the field and what it expects.
+// Sidecars that would break the node: an `extra` value a module reads late would abort it from inside
+// its sensor set-up (std::terminate), others would never be read and any value pass, a window of
+// 1e7 s would take the node past 24 GB, and a copied sidecar's level or material go unnoticed. Each
+// is refused when the sidecar loads, naming the field and what it expects.
 TEST(RobotDescription, SidecarEntriesAreCheckedWhenTheyLoad) {
   const std::pair<std::string, std::string> cases[][2] = {
       {{"ir_model: lut", "ir_model: psychic"}, {"extra.ir_model", "expected one of lut|raytrace, found 'psychic'"}},
@@ -220,11 +220,11 @@ TEST(RobotDescription, SidecarEntriesAreCheckedWhenTheyLoad) {
   }
 }
 
-// A second outside probe (2026-11-29, thirty-fifth session): these descriptions aborted the process
+// Descriptions that would abort the process
 // inside ODE (an inertia that is not positive definite, 1e300 offsets or gravity, a NaN loop-joint
-// anchor or a zero axis), or escaped as std::out_of_range (a fixed turret joint) or as yaml-cpp's
-// own words (a section that is no mapping, a key that is a list), or loaded with a typo or a
-// contradiction unseen. Each is now refused when it loads, naming the field.
+// anchor or a zero axis), or escape as std::out_of_range (a fixed turret joint) or as yaml-cpp's
+// own words (a section that is no mapping, a key that is a list), or load with a typo or a
+// contradiction unseen. Each is refused when it loads, naming the field.
 TEST(RobotDescription, WhatODEWouldAbortOnIsRefusedWhenItLoads) {
   struct Case {
     std::string level, file, anchor, from, to, field, words;

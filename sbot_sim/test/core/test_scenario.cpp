@@ -117,7 +117,7 @@ TEST(Scenario, RefusesValuesThatWouldMisbehaveLater) {
   refused("world: {contact: {bounce: 2}}", "'world.contact.bounce': must be in [0, 1]");
   refused("world: {contact: {max_contacts: 17}}", "'world.contact.max_contacts': must be a whole number in [1, 16]");
   refused("world: {contact: {materials: {track: -1}}}", "'world.contact.materials.track': must be >= 0");
-  // A coefficient for a name nothing is made of never applied (an outside probe, 2026-11-29).
+  // A coefficient for a name nothing is made of would never apply.
   refused("world: {contact: {materials: {lava: 1}}}", "'world.contact.materials.lava': no robot material or terrain surface");
   EXPECT_EQ(parseScenario("world: {contact: {materials: {lava: 0.2}}, terrain: {type: composite, boxes: "
                           "[{center: [1, 0, 0.05], size: [0.1, 0.1, 0.1], surface: lava}]}}",
@@ -127,7 +127,7 @@ TEST(Scenario, RefusesValuesThatWouldMisbehaveLater) {
           "'world.terrain.boxes[1].name': 'a' names another box too");
   refused("world: {gravity: 1e30}", "'world.gravity': must be <= 1000 m/s^2");
   refused("world: {sleep_at_rest: sometimes}", "'world.sleep_at_rest': expected true or false");
-  // Aborted inside ODE, or hung there (an outside probe, 2026-11-29, thirty-fifth session):
+  // Values that abort inside ODE, or hang there:
   // over-relaxation from 2 on diverges; a rough terrain of 1 cm took minutes a step, of 1e-300 m aborted.
   refused("world: {solver_sor: 3}", "'world.solver_sor': must be in [0.01, 1.99], found 3");
   refused("world: {terrain: {type: rough, size: 0.01}}", "'world.terrain.size': must be in [0.1, 10000], found 0.01");

@@ -286,16 +286,16 @@ double headingChange(const std::string& level, const std::string& solver, int un
 TEST(Treels, WeldedTurretsKeepTheHeadingUnderQuickstep) {
   // Quickstep does not converge on the turret hinged 3 cm off its centre of mass: standing or at
   // 60 units, Basic and Medium turn 5-7 deg in 10 s. Welded while idle (opt-in WorldConfig::
-  // lock_idle_turret) they turn 0.0-1.4 deg (README, "Yaw drift and the turret weld").
+  // lock_idle_turret) they turn 0.0-1.4 deg (docs/model.md, "Yaw drift under quickstep").
   for (const std::string level : {"simple", "basic", "medium", "detailed"}) {
     EXPECT_LT(std::abs(headingChange(level, "quickstep", 0, true)), 2.0) << level << " standing";
-    // Detailed hardly drifts on its hinge (-0.9 deg driving); welded it turns +0.7 deg (+4.1 before
-    // 2026-11-27). The weld is for Basic and Medium (+0.7 and -0.8 deg driving).
+    // Detailed hardly drifts on its hinge (-0.9 deg driving); welded it turns +0.7 deg. The weld
+    // is for Basic and Medium (+0.7 and -0.8 deg driving).
     const double driving_bound = level == "detailed" ? 5.0 : 4.0;
     EXPECT_LT(std::abs(headingChange(level, "quickstep", 60, true)), driving_bound) << level << " driving";
   }
-  // The drift the weld removes (2026-11-27: Medium -5.0 deg driving, Basic -6.4; with the turret's
-  // centre of mass 4 cm off its axis, before then, -6.7 and -7.5).
+  // The drift the weld removes (Medium -5.0 deg driving, Basic -6.4; with Table 2.3's turret
+  // centre of mass, 4 cm off its axis, -6.7 and -7.5).
   EXPECT_GT(std::abs(headingChange("medium", "quickstep", 60)), 3.0) << "the drift the weld removes";
   EXPECT_GT(std::abs(headingChange("basic", "quickstep", 60)), 3.0) << "the drift the weld removes";
 }
@@ -334,9 +334,9 @@ TEST(DriveWheelLoad, SixDrivenWheelsCarryTheWholeWeight) {
 
 TEST(DriveWheelLoad, SimpleStandsOnItsWheelsUnderQuickstep) {
   // The casters are 2 mm above the wheels' ground plane, so the wheels should carry the weight.
-  // With 20 g wheels (before 2026-12-01) they did not at 20 quickstep iterations: the hinges sagged
-  // ~1.4 mm under the 360 g turret and the chassis sat on its frictionless casters (48 % on the
-  // wheels). The 45 g wheels carry it (sbot_description/README.md, "Simple on its wheels").
+  // With 20 g wheels they do not at 20 quickstep iterations: the hinges sag ~1.4 mm under the
+  // 360 g turret and the chassis sits on its frictionless casters (48 % on the wheels). The 45 g
+  // wheels carry it (docs/model.md, "Casters and running gear").
   World w(flatWorld());
   Robot& r = w.addRobot(loadLevel("simple"), {0, 0, 0}, "sbot_0");
   runFor(w, 1.0);
@@ -375,8 +375,8 @@ double basicWheelShareByStatics(const Robot& r) {
 
 TEST(DriveWheelLoad, BasicLeansOnItsFrontCasterAsItsCentreOfMassSays) {
   // Converged (exact solver) the wheels carry what statics say. Quickstep at 20 iterations leaves
-  // the wheel hinges sagging a little and the casters take a few % of the weight more (with the
-  // 20 g wheels before 2026-12-01: 0.506 against 0.556).
+  // the wheel hinges sagging a little and the casters take a few % of the weight more (with 20 g
+  // wheels: 0.506 against 0.556).
   const std::map<std::string, double> tolerance{{"exact", 0.01}, {"quickstep", 0.07}};
   for (const auto& [solver, tol] : tolerance) {
     WorldConfig c = flatWorld();
@@ -432,7 +432,7 @@ TEST(Treels, EveryLevelDrivesAlongItsHeadingWhateverItsSpawnYaw) {
 // the centre wheels' 8.2 cm (Table 2.2) on every full-size level. Medium's mean over its six
 // wheels, 5.5 cm, turned it at 58-68 % of the commanded rate. A slow spin (10 units, ~0.7 rad/s)
 // turns Fast, Simple, Basic and Medium within 5 % of that rate. Detailed's teethed wheels skid
-// (about 70 % of it at 10 units): its own physics, not its width (README, the cmd_vel row of "ROS interface").
+// (about 70 % of it at 10 units): its own physics, not its width (docs/model.md, "The levels turn at different rates").
 TEST(Treels, TrackWidthIsTheWidthTheRobotTurnsOn) {
   for (const std::string level : {"fast", "simple", "basic", "medium", "detailed"}) {
     const RobotDescription& d = loadLevel(level);
@@ -618,9 +618,9 @@ TEST(TrackCreep, ClimbingTracksSlipByTheirTractionRatioOverTheCreepStiffness) {
   ASSERT_GT(C, 0) << "the levels creep";
   // Flat: hardly any traction, hardly any creep.
   EXPECT_NEAR(climbEfficiency(0, 10, true), climbEfficiency(0, 10, false), 0.01);
-  // Climbing, the tracks pull with F/N = tan(slope): the speed lost is tan(slope) / C. Measured
-  // (2026-11-26): 17-31 % more than that at 20-35 deg, before and after the Detailed turret's COM
-  // calibration (35 deg: 27 % and 31 %); why it exceeds tan / C is not analysed.
+  // Climbing, the tracks pull with F/N = tan(slope): the speed lost is tan(slope) / C. Measured:
+  // 17-31 % more than that at 20-35 deg, with Table 2.3's and with the calibrated turret COM
+  // (35 deg: 27 % and 31 %); why it exceeds tan / C is not analysed.
   for (double deg : {20.0, 30.0, 35.0}) {
     const double without = climbEfficiency(deg, 10, false), with = climbEfficiency(deg, 10, true);
     const double lost = without - with;
@@ -695,8 +695,8 @@ TEST(TreelsFriction, TheLevelsScaleMultipliesTheTrackMaterialsMu) {
 }
 
 TEST(TreelsFriction, ForceLimitLawHoldsEachContactToAFixedForce) {
-  // The seed's friction law (sidecar treels.friction_law: force_limit; no level uses it, see
-  // "Medium's friction law" in src/validation/README.md): each terrain contact holds up to
+  // The seed's friction law (sidecar treels.friction_law: force_limit; Medium uses it, see
+  // docs/model.md, "Friction"): each terrain contact holds up to
   // friction_force_limit whatever its load. A Medium s-bot holding (setSpeed(0, 0)) on 30 deg
   // needs 6.5 N x sin 30 = 3.2 N: its six spheres at 1.2 N each hold it, at 0.3 N each (1.8 N in
   // all) it slides; Coulomb (mu 1 > tan 30) holds.
@@ -731,7 +731,7 @@ TEST(TreelsFriction, APyramidOnAFaceAheadRunsUpTheFace) {
   // its diagonal friction reaches 1.41 mu N. On a floor its first direction is the heading. On a
   // face the robot drives into, the heading's projection is only the remnant of a small yaw: a
   // direction that turned the pyramid about the face's normal and let a Detailed robot at mu 0.5
-  // hold itself up a step's face on 0.69 N per 1 N pressed (2026-11-27). The first direction is
+  // hold itself up a step's face on 0.69 N per 1 N pressed. The first direction is
   // the way the wheels roll instead: up the face, the heading on the floor.
   WorldConfig c = flatWorld();
   c.terrain.boxes.push_back({"wall", Vec3(0.20, 0, 0.1), Vec3(0.05, 1.0, 0.2), 0, 0, "wall"});

@@ -90,8 +90,8 @@ class TestMalformedScenario(unittest.TestCase):
         self.assertRefused(self.run_node('_scenario:=' + scenario, '_effects:=' + effects), effects,
                            'effects[0].params.delay')
 
-    # An outside probe (2026-11-29) found these crashing the node (a stack overflow, an abort from
-    # inside the sensor set-up) or passing without a word.
+    # Each of these would crash the node (a stack overflow, an abort from inside the sensor
+    # set-up) or pass without a word if it were not refused.
     def scenario_with(self, world_lines):
         """three_robots.yaml with `world_lines` added under world:, as a temporary file."""
         with open(self.fixture('three_robots.yaml')) as f:

@@ -68,7 +68,7 @@ class TestSimServices(unittest.TestCase):
         self.assertAlmostEqual(wrap(yaw_of(p.orientation) - 0.3), 0.0, delta=0.02)
 
     def test_set_pose_into_the_ground_or_a_robot_fails_and_leaves_it(self):
-        # Accepted until 2026-11-29: a robot 5 m under the floor then rose through it at 0.5 m/s.
+        # Accepted, a robot 5 m under the floor would rise through it at 0.5 m/s.
         t = self.sim.step_ok(self, 5)
         before = self.odom.wait_stamp(t).pose.pose.position
         res = self.sim.set_pose('sbot_2', 0.3, 0.3, -5.0, 0.0)

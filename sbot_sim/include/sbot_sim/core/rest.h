@@ -3,13 +3,13 @@
 //
 // Why: ODE's iterative solver (quickstep, 20-40 iterations) does not converge on a standing
 // robot's contacts and hinges. The residue moves robots that should stand: a Simple commanded
-// setSpeed(0, 0) slid 19 mm sideways in 10 s, a Basic 14 mm, a Medium 8 mm and turned (README,
+// setSpeed(0, 0) slid 19 mm sideways in 10 s, a Basic 14 mm, a Medium 8 mm and turned (docs/model.md,
 // "Sleeping at rest"). Real treels on their 150:1 gears do not move. Game and robot simulators answer
 // the same artefact the same way (ODE's own auto-disable, Bullet's deactivation); ours watches
 // displacement over a window rather than instantaneous speed, because quickstep's jitter at rest
 // (a standing Simple rocks by up to 1.3 deg) is faster than any speed threshold that would not also
 // freeze real slow motion. Robots that touch or are joined settle at different times; World keeps
-// them from waking each other (README, "Sleeping at rest", *Neighbours and groups*).
+// them from waking each other (docs/model.md, "Sleeping at rest").
 #pragma once
 
 #include <ode/ode.h>

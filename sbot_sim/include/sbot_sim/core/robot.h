@@ -203,7 +203,7 @@ class Robot {
   /// Before collision: awake, tracks commanded to stand, no servo moving or commanded in the last
   /// kServoSettle_s, no body faster than kStandingSpeed, and none moved beyond the rest limits
   /// (RestConfig) in the last kMovedRecently_s. A sleeper it touches stays asleep and stands as a
-  /// static body for it (World::handlePair): settling neighbours no longer wake each other.
+  /// static body for it (World::handlePair): settling neighbours do not wake each other.
   bool standing() const { return standing_; }
   void updateStanding();
   static constexpr double kStandingSpeed = 0.08;  ///< [m/s] above quickstep's jitter at rest (<= 0.05)

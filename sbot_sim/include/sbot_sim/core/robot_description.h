@@ -124,8 +124,8 @@ RobotDescription loadRobotDescription(const std::string& urdf_path, const std::s
 /// set, otherwise the sbot_description source directory this library was built against.
 std::string descriptionDirectory();
 
-/// The contact materials a robot's links can be made of (sidecar `materials`; README of
-/// sbot_description): a scenario's contact.materials may name these and the terrain's surfaces.
+/// The contact materials a robot's links can be made of (sidecar `materials`;
+/// sbot_description/README.md): a scenario's contact.materials may name these and the terrain's surfaces.
 const std::set<std::string>& robotMaterials();
 
 /// The five model levels, cheapest first.

@@ -107,9 +107,9 @@ struct WorldConfig {
   /// ODE stepper. "quickstep" (default): iterative, the validated configuration. "exact":
   /// dWorldStep's direct LCP solve per island: no yaw drift for Simple/Basic/Medium and faster for
   /// them, but ODE reports LCP failures on Detailed and the validation tables fall apart with it
-  /// (README, "Yaw drift and the turret weld"; src/validation/README.md, "Solver").
+  /// (docs/model.md, "Yaw drift under quickstep"; docs/validation.md, "Solver").
   std::string solver = "quickstep";
-  int solver_iterations = 20;  ///< ODE quickstep iterations (ODE default; see README benchmark)
+  int solver_iterations = 20;  ///< ODE quickstep iterations (ODE default; docs/model.md, "Solver")
   /// Raise the iterations to what the robots' levels need (RobotDescription::solver_iterations,
   /// Medium: 25, Detailed: 40) while such a robot is in the world. Off only to study the solver itself.
   bool level_iterations = true;
