@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Every relative link and #anchor in the user documentation resolves (ctest docs_links).
 
 Checked: README.md, every markdown file under docs/, and every README.md of a package or tool
