@@ -120,7 +120,7 @@ struct WorldConfig {
   /// turret's 4 cm off-axis centre of mass hinged to the treels: a standing Medium turns -11 deg in
   /// 10 s on the hinge, +1.5 welded. Off by default: welded robots with the turret turned round
   /// and the gripper raised tilt 11 deg in an abrupt spin (hinge 4, exact solver 0.3) and toppled
-  /// in the obstacle-avoidance scenario (README, "Yaw drift and the turret weld").
+  /// in the obstacle-avoidance scenario (docs/model.md, "Yaw drift under quickstep").
   bool lock_idle_turret = false;
   RestConfig rest;
   std::uint64_t seed = 1;      ///< root of every random stream
