@@ -1,7 +1,7 @@
 /* sbot.h : c interface to the s-bot robot (c) 2003 Stephane Magnenat, LSA 2, EPFL, SwarmBot Project
  *
  * The standard s-bot API exactly as in the Swarmbot3d technical report, Appendix A. In this
- * repository it is implemented over ROS by libsbot_ros (sbot_controllers/src/sbot_ros.cpp) against
+ * repository it is implemented over ROS by libsbot_ros (sbot_controllers/src/sbot_ros/) against
  * the swarmbot3d simulator: a controller written for the real s-bot compiles and runs unchanged.
  * See sbot_controllers/README.md for how each function maps to topics and services.
  */

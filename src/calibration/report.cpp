@@ -152,104 +152,82 @@ VariantSummary summarise(const Dataset& ds, const Evaluation& ev, const std::str
   return s;
 }
 
-std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
-                                               const std::vector<std::pair<std::string, ModelSpec>>& variants,
-                                               const CompareOptions& opt, WorkerPool& pool) {
-  makeOutputDirectory(opt.out_dir + "/data");
-  makeOutputDirectory(opt.out_dir + "/plots");
-  EvalOptions eo = opt.eval;
-  eo.replay.keep_trace = true;
-  std::vector<VariantSummary> sums;
-  std::vector<Evaluation> evals;
-  for (std::size_t vi = 0; vi < variants.size(); ++vi) {
-    Evaluation ev = evaluate(ds, variants[vi].second, allRuns(ds), eo, pool);
-    sums.push_back(summarise(ds, ev, variants[vi].first, variants[vi].second));
-    sums.back().sensitivity = replaySensitivity(ds, variants[vi].second, opt.eval, pool);
-    // Per-sample data and traces for the plots.
-    const std::string vdir = opt.out_dir + "/data/v" + std::to_string(vi);
-    makeOutputDirectory(vdir);
-    for (const auto& rr : ev.runs) {
-      const Run& run = ds.runs[rr.run];
-      OutputFile o(vdir + "/" + run.name + ".csv");
-      o << "channel,t,measured,predicted,residual,normalised,valid,v,w,accel,contact,yaw,distance,incidence,surface\n";
-      o << std::setprecision(9);
-      for (std::size_t ci = 0; ci < rr.channels.size(); ++ci) {
-        const std::string& c = rr.channels[ci];
-        const Series& ser = run.channels.at(c);
-        const auto& pred = rr.prediction.values.at(c);
-        const auto fit = rr.prediction.features.find(c);
-        const auto sit = rr.prediction.surface.find(c);
-        std::size_t k = 0;
-        for (std::size_t i = 0; i < rr.r.size(); ++i) {
-          if (rr.chan[i] != static_cast<int>(ci)) continue;
-          const std::size_t idx = k++;
-          auto feat = [&](const char* name) {
-            if (fit == rr.prediction.features.end()) return std::string();
-            auto it = fit->second.find(name);
-            if (it == fit->second.end() || idx >= it->second.size() || !std::isfinite(it->second[idx])) return std::string();
-            std::ostringstream s;
-            s << std::setprecision(7) << it->second[idx];
-            return s.str();
-          };
-          o << c << "," << ser.t[idx] << "," << ser.v[idx] << "," << (std::isfinite(pred[idx]) ? f(pred[idx], 9) : "")
-            << "," << (rr.valid[i] ? f(rr.raw[i], 9) : "") << "," << (rr.valid[i] ? f(rr.r[i], 7) : "") << ","
-            << static_cast<int>(rr.valid[i]) << "," << feat("v") << "," << feat("w") << "," << feat("accel") << ","
-            << feat("contact") << "," << feat("yaw") << "," << feat("distance") << "," << feat("incidence") << ","
-            << (sit != rr.prediction.surface.end() && idx < sit->second.size() ? sit->second[idx] : "") << "\n";
-        }
-      }
-      o.commit();
-      const Trace& tr = rr.prediction.trace;
-      if (!tr.t.empty()) {
-        OutputFile t(vdir + "/" + run.name + "_trace.csv");
-        t << "t,x,y,yaw,v,w,cmd_left,cmd_right,speed_left,speed_right,contact\n" << std::setprecision(8);
-        for (std::size_t i = 0; i < tr.t.size(); i += 3)
-          t << tr.t[i] << "," << tr.x[i] << "," << tr.y[i] << "," << tr.yaw[i] << "," << tr.v[i] << "," << tr.w[i]
-            << "," << tr.cmd_left[i] << "," << tr.cmd_right[i] << ","
-            << (i < tr.speed_left.size() ? tr.speed_left[i] : 0) << ","
-            << (i < tr.speed_right.size() ? tr.speed_right[i] : 0) << "," << static_cast<int>(tr.contact[i]) << "\n";
-        t.commit();
-      }
+namespace {
+
+/// data/v<i>/<run>.csv (every sample of every channel with its features) and <run>_trace.csv (the
+/// simulated trajectory, every third step) of one variant's replay of one run, for the plots.
+void writeRunData(const Dataset& ds, const RunResiduals& rr, const std::string& vdir) {
+  const Run& run = ds.runs[rr.run];
+  OutputFile o(vdir + "/" + run.name + ".csv");
+  o << "channel,t,measured,predicted,residual,normalised,valid,v,w,accel,contact,yaw,distance,incidence,surface\n";
+  o << std::setprecision(9);
+  for (std::size_t ci = 0; ci < rr.channels.size(); ++ci) {
+    const std::string& c = rr.channels[ci];
+    const Series& ser = run.channels.at(c);
+    const auto& pred = rr.prediction.values.at(c);
+    const auto fit = rr.prediction.features.find(c);
+    const auto sit = rr.prediction.surface.find(c);
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < rr.r.size(); ++i) {
+      if (rr.chan[i] != static_cast<int>(ci)) continue;
+      const std::size_t idx = k++;
+      auto feat = [&](const char* name) {
+        if (fit == rr.prediction.features.end()) return std::string();
+        auto it = fit->second.find(name);
+        if (it == fit->second.end() || idx >= it->second.size() || !std::isfinite(it->second[idx])) return std::string();
+        std::ostringstream s;
+        s << std::setprecision(7) << it->second[idx];
+        return s.str();
+      };
+      o << c << "," << ser.t[idx] << "," << ser.v[idx] << "," << (std::isfinite(pred[idx]) ? f(pred[idx], 9) : "")
+        << "," << (rr.valid[i] ? f(rr.raw[i], 9) : "") << "," << (rr.valid[i] ? f(rr.r[i], 7) : "") << ","
+        << static_cast<int>(rr.valid[i]) << "," << feat("v") << "," << feat("w") << "," << feat("accel") << ","
+        << feat("contact") << "," << feat("yaw") << "," << feat("distance") << "," << feat("incidence") << ","
+        << (sit != rr.prediction.surface.end() && idx < sit->second.size() ? sit->second[idx] : "") << "\n";
     }
-    evals.push_back(std::move(ev));
   }
+  o.commit();
+  const Trace& tr = rr.prediction.trace;
+  if (!tr.t.empty()) {
+    OutputFile t(vdir + "/" + run.name + "_trace.csv");
+    t << "t,x,y,yaw,v,w,cmd_left,cmd_right,speed_left,speed_right,contact\n" << std::setprecision(8);
+    for (std::size_t i = 0; i < tr.t.size(); i += 3)
+      t << tr.t[i] << "," << tr.x[i] << "," << tr.y[i] << "," << tr.yaw[i] << "," << tr.v[i] << "," << tr.w[i]
+        << "," << tr.cmd_left[i] << "," << tr.cmd_right[i] << ","
+        << (i < tr.speed_left.size() ? tr.speed_left[i] : 0) << ","
+        << (i < tr.speed_right.size() ? tr.speed_right[i] : 0) << "," << static_cast<int>(tr.contact[i]) << "\n";
+    t.commit();
+  }
+}
 
-  // summary.json for plot_report.py
-  {
-    OutputFile j(opt.out_dir + "/summary.json");
-    j << std::setprecision(9) << "{\n  \"dataset\": \"" << jsonEscape(ds.name) << "\",\n  \"window\": " << opt.window
-      << ",\n  \"runs\": [";
-    for (std::size_t i = 0; i < ds.runs.size(); ++i)
-      j << (i ? ", " : "") << "{\"name\": \"" << jsonEscape(ds.runs[i].name) << "\", \"kind\": \""
-        << (ds.runs[i].kind == RunKind::Drive ? "drive" : "place") << "\", \"t_end\": " << ds.runs[i].t_end << "}";
-    j << "],\n  \"variants\": [\n";
-    for (std::size_t vi = 0; vi < sums.size(); ++vi) {
-      const auto& s = sums[vi];
-      j << "    {\"label\": \"" << jsonEscape(s.label) << "\", \"model\": \"" << jsonEscape(s.model.describe())
-        << "\", \"dir\": \"data/v" << vi << "\", \"nrms\": " << (std::isfinite(s.nrms) ? s.nrms : -1)
-        << ", \"group_nrms\": {";
-      bool first = true;
-      for (const auto& [g, v] : s.group_nrms) {
-        j << (first ? "" : ", ") << "\"" << g << "\": " << v;
-        first = false;
-      }
-      j << "}}" << (vi + 1 < sums.size() ? "," : "") << "\n";
+/// summary.json for plot_report.py.
+void writeSummaryJson(const Dataset& ds, const std::vector<VariantSummary>& sums, const CompareOptions& opt) {
+  OutputFile j(opt.out_dir + "/summary.json");
+  j << std::setprecision(9) << "{\n  \"dataset\": \"" << jsonEscape(ds.name) << "\",\n  \"window\": " << opt.window
+    << ",\n  \"runs\": [";
+  for (std::size_t i = 0; i < ds.runs.size(); ++i)
+    j << (i ? ", " : "") << "{\"name\": \"" << jsonEscape(ds.runs[i].name) << "\", \"kind\": \""
+      << (ds.runs[i].kind == RunKind::Drive ? "drive" : "place") << "\", \"t_end\": " << ds.runs[i].t_end << "}";
+  j << "],\n  \"variants\": [\n";
+  for (std::size_t vi = 0; vi < sums.size(); ++vi) {
+    const auto& s = sums[vi];
+    j << "    {\"label\": \"" << jsonEscape(s.label) << "\", \"model\": \"" << jsonEscape(s.model.describe())
+      << "\", \"dir\": \"data/v" << vi << "\", \"nrms\": " << (std::isfinite(s.nrms) ? s.nrms : -1)
+      << ", \"group_nrms\": {";
+    bool first = true;
+    for (const auto& [g, v] : s.group_nrms) {
+      j << (first ? "" : ", ") << "\"" << g << "\": " << v;
+      first = false;
     }
-    j << "  ]\n}\n";
-    j.commit();
+    j << "}}" << (vi + 1 < sums.size() ? "," : "") << "\n";
   }
+  j << "  ]\n}\n";
+  j.commit();
+}
 
-  // The plots, drawn by plot_report.py from summary.json and the CSV files above. A reused output
-  // folder must not show an earlier dataset's plots.
-  for (const char* png : {"heatmap.png", "trajectories.png", "residual_time.png", "residual_features.png", "parity.png",
-                          "sensor_features.png", "before_after.png", "waterfall.png"})
-    std::remove((opt.out_dir + "/plots/" + png).c_str());
-  const std::string plot_problem =
-      opt.plots ? runScript("/usr/bin/python3", {scriptDirectory() + "/plot_report.py", opt.out_dir}) : "";
-  const bool drawn = opt.plots && plot_problem.empty();
-
-  // The Markdown report.
-  OutputFile md(opt.out_dir + "/report.md");
+/// The report's title, dataset, units and notes, and the summary table.
+void writeSummary(OutputFile& md, const Dataset& ds, const std::vector<std::pair<std::string, ModelSpec>>& variants,
+                  const std::vector<VariantSummary>& sums, bool drawn) {
   md << "# Model vs measurements: " << ds.name << "\n\n";
   md << "Dataset `" << ds.yaml_path << "` (" << ds.runs.size() << " runs, " << ds.sampleCount()
      << " measured samples), model level **" << (variants.empty() ? ds.robot : variants.front().second.level)
@@ -286,8 +264,10 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
     md << "### Before / after\n\n![before and after](plots/before_after.png)\n\n"
        << "### Waterfall (effects added one by one)\n\n![waterfall](plots/waterfall.png)\n\n";
   }
+}
 
-  // Which residuals can be read as missing physics at all (evaluation.h, ReplaySensitivity).
+/// Which residuals can be read as missing physics at all (evaluation.h, ReplaySensitivity).
+void writeReproducibility(OutputFile& md, const Dataset& ds, const std::vector<VariantSummary>& sums) {
   bool any_drive = false;
   for (const auto& s : sums) any_drive |= !s.sensitivity.empty();
   if (any_drive) {
@@ -311,7 +291,9 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
     }
     md << "\n";
   }
+}
 
+void writePerRunChannel(OutputFile& md, const std::vector<VariantSummary>& sums) {
   md << "## Per run and channel\n\n";
   md << "| run | channel | unit | n |";
   for (const auto& s : sums) md << " RMSE " << s.label << " | fit % " << s.label << " | nRMS " << s.label << " |";
@@ -330,8 +312,10 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
     }
   }
   md << "\n";
-  // Per sensor (ir/ground/light) over all runs
-  std::map<std::string, std::vector<double>> sensor_nrms;
+}
+
+/// Per sensor (ir/ground/light) over all runs; whether the dataset has such sensors.
+bool writePerSensor(OutputFile& md, const std::vector<VariantSummary>& sums) {
   bool sensors = false;
   for (const auto& s : sums)
     for (const auto& c : s.channels) {
@@ -369,8 +353,12 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
     }
     md << "\n";
   }
+  return sensors;
+}
 
-  // The plots of the failures.
+/// The plots of the failures (or why there are none).
+void writePlotSection(OutputFile& md, const CompareOptions& opt, bool sensors, bool drawn,
+                      const std::string& plot_problem) {
   std::vector<std::pair<std::string, std::string>> plots = {
       {"Error by run and time window", "heatmap.png"},
       {"Trajectories (measured vs simulated, open loop from the start pose)", "trajectories.png"},
@@ -383,6 +371,47 @@ std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
   else if (!drawn) md << "> plots could not be drawn: " << plot_problem << "\n\n";
   else
     for (const auto& [title, file] : plots) md << "### " << title << "\n\n![" << title << "](plots/" << file << ")\n\n";
+}
+
+/// The plots, drawn by plot_report.py from summary.json and the CSV files. A reused output folder
+/// must not show an earlier dataset's plots. "" when drawn (or not asked for), else the problem.
+std::string drawPlots(const CompareOptions& opt) {
+  for (const char* png : {"heatmap.png", "trajectories.png", "residual_time.png", "residual_features.png", "parity.png",
+                          "sensor_features.png", "before_after.png", "waterfall.png"})
+    std::remove((opt.out_dir + "/plots/" + png).c_str());
+  return opt.plots ? runScript("/usr/bin/python3", {scriptDirectory() + "/plot_report.py", opt.out_dir}) : "";
+}
+
+}  // namespace
+
+std::vector<VariantSummary> writeCompareReport(const Dataset& ds,
+                                               const std::vector<std::pair<std::string, ModelSpec>>& variants,
+                                               const CompareOptions& opt, WorkerPool& pool) {
+  makeOutputDirectory(opt.out_dir + "/data");
+  makeOutputDirectory(opt.out_dir + "/plots");
+  EvalOptions eo = opt.eval;
+  eo.replay.keep_trace = true;
+  std::vector<VariantSummary> sums;
+  for (std::size_t vi = 0; vi < variants.size(); ++vi) {
+    Evaluation ev = evaluate(ds, variants[vi].second, allRuns(ds), eo, pool);
+    sums.push_back(summarise(ds, ev, variants[vi].first, variants[vi].second));
+    sums.back().sensitivity = replaySensitivity(ds, variants[vi].second, opt.eval, pool);
+    // Per-sample data and traces for the plots.
+    const std::string vdir = opt.out_dir + "/data/v" + std::to_string(vi);
+    makeOutputDirectory(vdir);
+    for (const auto& rr : ev.runs) writeRunData(ds, rr, vdir);
+  }
+  writeSummaryJson(ds, sums, opt);
+  const std::string plot_problem = drawPlots(opt);
+  const bool drawn = opt.plots && plot_problem.empty();
+
+  // The Markdown report.
+  OutputFile md(opt.out_dir + "/report.md");
+  writeSummary(md, ds, variants, sums, drawn);
+  writeReproducibility(md, ds, sums);
+  writePerRunChannel(md, sums);
+  const bool sensors = writePerSensor(md, sums);
+  writePlotSection(md, opt, sensors, drawn, plot_problem);
   md.commit();
   if (!plot_problem.empty())
     std::fprintf(stderr, "sbot_calibrate: warning: plots could not be drawn: %s\n", plot_problem.c_str());

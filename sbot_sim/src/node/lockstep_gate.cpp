@@ -19,7 +19,7 @@ double secondsBetween(SteadyClock::time_point a, SteadyClock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
 }
 
-/// The topics libsbot_ros's getters read (sbot_controllers/src/sbot_ros.cpp, class Latest), and
+/// The topics libsbot_ros's getters read (sbot_controllers/src/sbot_ros/latest.h, class Latest), and
 /// ground_truth (random_walk_node), whose publishers note their stamps in publicationStamps().
 const std::set<std::string>& trackedChannels() {
   static const std::set<std::string> channels = {"proximity", "ground", "light", "slope", "battery", "climate",

@@ -28,6 +28,7 @@
 //   sensors_available    sbot_msgs/SensorsAvailable latched
 //   leds                 sbot_msgs/LedState         command (subscribed): all 8 groups at once
 //   speaker              std_msgs/Float64           command: frequency [Hz], <= 0 = silence
+// Each sensor family's topics are one SensorPublisher (sensor_publishers/, registered in its table.h).
 // Services: set_gripper, set_side_arm, set_leds, set_sampling_rate (sbot_msgs/Set*).
 // World: /sim/set_lamp, /sim/set_ambient_light; lamps and ambient light from the scenario YAML's
 // world.lamps [{position: [x,y,z], intensity: mcd, colour: [r,g,b]}] and world.ambient_light.
@@ -38,7 +39,6 @@
 #include <string>
 #include <vector>
 
-#include <image_transport/image_transport.h>
 #include <ros/ros.h>
 #include <sbot_msgs/LedState.h>
 #include <sbot_msgs/SetAmbientLight.h>
@@ -49,14 +49,8 @@
 #include <sbot_msgs/SetSideArm.h>
 #include <std_msgs/Float64.h>
 
-#include "publication_stamps.h"
-#include "sbot_sim/core/actuators/gripper.h"
-#include "sbot_sim/core/actuators/side_arm.h"
 #include "sbot_sim/core/scenario.h"
-#include "sbot_sim/core/sensors/environment.h"
-#include "sbot_sim/core/sensors/raw_camera.h"
-#include "sbot_sim/core/sensors/sensor_suite.h"
-#include "sbot_sim/core/world.h"
+#include "sensor_publishers/sensor_publisher.h"
 
 namespace sbot_node {
 
@@ -70,7 +64,7 @@ class RobotModulesRos {
   ~RobotModulesRos();
   void bind(sbot::World& world, sbot::sensors::Environment& env, sbot::Robot& robot);
   void unbind();
-  bool bound() const { return robot_ != nullptr; }
+  bool bound() const { return topics_.robot != nullptr; }
   const std::string& name() const { return name_; }
   /// After every world step: module updates (battery, gripper, side arm) and due publications.
   void update(double dt, double sim_time);
@@ -78,19 +72,7 @@ class RobotModulesRos {
   sbot::actuators::FrontGripper* gripper() { return gripper_.get(); }
 
  private:
-  struct Rate {
-    double hz = 10;
-    double next = 0;
-  };
-  bool due(const std::string& channel, double t);
-  /// A channel with a compact array topic (key `channel`) and optional per-sensor topics (keys
-  /// single_prefix + k, k < count): true when its period has come and anyone listens to either;
-  /// any_single says whether the per-sensor messages are wanted.
-  bool dueWithSingles(const std::string& channel, const std::string& single_prefix, int count, double t,
-                      bool& any_single);
   void publishAvailable();
-  void publishMarkers(const ros::Time& stamp);
-  void publishRawCamera(const ros::Time& stamp, bool with_image);  ///< camera_info always, the image if asked
   void onLeds(const sbot_msgs::LedState::ConstPtr& msg);
   void onSpeaker(const std_msgs::Float64::ConstPtr& msg);
   bool onSetGripper(sbot_msgs::SetGripper::Request& req, sbot_msgs::SetGripper::Response& res);
@@ -98,27 +80,16 @@ class RobotModulesRos {
   bool onSetLeds(sbot_msgs::SetLeds::Request& req, sbot_msgs::SetLeds::Response& res);
   bool onSetSamplingRate(sbot_msgs::SetSamplingRate::Request& req, sbot_msgs::SetSamplingRate::Response& res);
 
-  ros::NodeHandle nh_, pnh_;
   std::string name_;
-  sbot::World* world_ = nullptr;
-  sbot::sensors::Environment* env_ = nullptr;
-  sbot::Robot* robot_ = nullptr;
   std::unique_ptr<sbot::sensors::SensorSuite> suite_;
   std::unique_ptr<sbot::actuators::FrontGripper> gripper_;
   std::unique_ptr<sbot::actuators::SideArm> side_arm_;
-  std::unique_ptr<sbot::sensors::RawCamera> raw_camera_;
-  sbot::sensors::RawCameraParams camera_params_;
-  /// Subscribers per channel / "ir_<k>" (connect callbacks); before the publishers, which it outlives.
-  std::map<std::string, SubscriberRoster> subs_;
-  // The image and its camera_info apart: a subscriber to camera_info alone (`rosbag record -a -x
-  // '.*image_raw.*'`) must not make every robot ray-cast an image nobody takes.
-  image_transport::Publisher camera_pub_;
-  ros::Publisher camera_info_pub_;
-  std::map<std::string, Rate> rates_;
-  double next_any_ = 0;  ///< [s] earliest rates_[*].next
-  std::map<std::string, ros::Publisher> pubs_;
-  std::vector<ros::Publisher> ir_pubs_;     ///< proximity/ir_<k> (sensor_msgs/Range)
-  std::vector<ros::Publisher> light_pubs_;  ///< light/sensor_<k> (sensor_msgs/Illuminance)
+  /// Node handle, subscriber rosters, rates and the modules above for the publishers; before them,
+  /// which it outlives.
+  RobotTopics topics_;
+  std::vector<std::unique_ptr<SensorPublisher>> publishers_;  ///< sensorPublisherTable()'s order
+  double next_any_ = 0;  ///< [s] earliest topics_.rates()[*].next
+  ros::Publisher available_pub_;
   ros::Subscriber leds_sub_, speaker_sub_;
   ros::ServiceServer set_gripper_srv_, set_side_arm_srv_, set_leds_srv_, set_rate_srv_;
 };
