@@ -235,8 +235,15 @@ class Robot {
     double raw_angle = 0;   ///< ODE's wrapped angle at the last update
   };
 
-  /// Builds from model_ (the level's description, or its copy with the turret welded).
+  /// Builds from model_ (the level's description, or its copy with the turret welded): the stages
+  /// below, in robot_build.cpp.
   void build(const Pose& base_pose);
+  struct LinkGroups;  ///< links grouped into rigid bodies (a fixed joint merges a child into its parent)
+  static LinkGroups groupLinks(const RobotDescription& d, const Pose& base_pose);
+  /// The body of group `gi` (its mass about its centre of mass) with its links' collision geoms.
+  void addGroupBody(const LinkGroups& groups, std::size_t gi, double inertia_floor);
+  void addHinges(const LinkGroups& groups);  ///< one ODE hinge per moving joint
+  void markDriveWheels();                    ///< the tracks' hinges and their wheels' geoms
   /// switchDescription's work: rebuild from `model` in place, carrying the state over
   /// (core/swarm/model_switch.cpp). description_ is already the level to be.
   void rebuild(const RobotDescription& model);

@@ -164,7 +164,7 @@ class World {
   std::vector<BoxedGeom> terrain_index_;        ///< static_space_'s geoms, in its order (never move)
   std::vector<BoxedGeom> robot_geoms_;          ///< collideWithTerrain's robot geoms (reused)
   void indexTerrain();  ///< fills terrain_index_ (after buildTerrain)
-  /// Contacts between a robot and the terrain (see world.cpp for why not dSpaceCollide2).
+  /// Contacts between a robot and the terrain (see world_contacts.cpp for why not dSpaceCollide2).
   void collideWithTerrain(Robot& r);
   /// Before the terrain is collided: wake every sleeping robot that a joint (a contact made this
   /// step, a connection, a static link) ties to an awake body, as ODE's island walk would mid-step.
