@@ -69,6 +69,14 @@ double Robot::jointEffort(const std::string& joint) const {
   return h ? h->effort : 0.0;
 }
 
+bool Robot::holdJoint(const std::string& joint, double max_torque) {
+  const dJointID h = hingeJoint(joint);
+  if (!h) return false;
+  dJointSetHingeParam(h, dParamVel, 0);
+  dJointSetHingeParam(h, dParamFMax, max_torque);
+  return true;
+}
+
 dBodyID Robot::linkBody(const std::string& link) const {
   auto it = link_index_.find(link);
   if (it == link_index_.end() || it->second.body < 0) return nullptr;
@@ -239,6 +247,22 @@ Vec3 Robot::linearVelocity() const {
 }
 
 Vec3 Robot::angularVelocity() const { return vec(dBodyGetAngularVel(baseBody())); }
+
+Vec3 Robot::centreOfMass(double* mass_out) const {
+  double m = 0;
+  Vec3 com = Vec3::Zero();
+  for (dBodyID b : bodies_) {
+    dMass mass;
+    dBodyGetMass(b, &mass);
+    const dReal* p = dBodyGetPosition(b);
+    com += mass.mass * Vec3(p[0], p[1], p[2]);
+    m += mass.mass;
+  }
+  if (mass_out) *mass_out = m;
+  return com / m;
+}
+
+void Robot::addBaseForce(const Vec3& force) { dBodyAddForce(baseBody(), force.x(), force.y(), force.z()); }
 
 std::vector<JointState> Robot::jointStates() const {
   std::vector<JointState> out;
@@ -479,7 +503,7 @@ void Robot::applyDriveReaction(const Quat& q) {
   // caster, which lifts the wheels, and it drops back instead of flipping over). Without it the
   // Fast robot pitched nose-down into every halved gap from 4.5 cm (Table 4.5).
   if (driven_wheel_contacts_ == 0) return;
-  const double push = (q.inverse() * vec(drive_linear_fb_.f1)).x();  // [N] along the heading
+  const double push = (q.inverse() * vec(drive_linear_fb_->f1)).x();  // [N] along the heading
   const Vec3 axle = q * Vec3::UnitY();
   const double torque = -push * description_->treels.wheel_radius;  // [N m] about +y: > 0 nose down
   dBodyAddTorque(baseBody(), torque * axle.x(), torque * axle.y(), torque * axle.z());
@@ -494,14 +518,14 @@ void Robot::readFeedback(double dt) {
     // child's centre of mass lies on or near the axis, so the constraint force adds ~nothing.
     dVector3 a;
     dJointGetHingeAxis(h.id, a);
-    h.effort = vec(h.feedback.t1).dot(Vec3(a[0], a[1], a[2]));
+    h.effort = vec(h.feedback->t1).dot(Vec3(a[0], a[1], a[2]));
   }
   if (drive_linear_) {
     // Motor forces back to per-track axle torques: forward force shared equally, yaw torque as a
     // force couple of the two tracks.
     const Quat q = bodyPose(baseBody()).orientation;
-    const double forward = (q.inverse() * vec(drive_linear_fb_.f1)).x();
-    const double yaw = (q.inverse() * vec(drive_angular_fb_.t1)).z();
+    const double forward = (q.inverse() * vec(drive_linear_fb_->f1)).x();
+    const double yaw = (q.inverse() * vec(drive_angular_fb_->t1)).z();
     const double r = description_->treels.wheel_radius;
     drive_torque_[0] = (0.5 * forward - yaw / track_width_) * r;
     drive_torque_[1] = (0.5 * forward + yaw / track_width_) * r;

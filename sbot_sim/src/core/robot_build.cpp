@@ -234,10 +234,11 @@ void Robot::addHinges(const LinkGroups& groups) {
       dJointSetHingeParam(h.id, dParamHiStop, j.upper);
     }
     dJointSetHingeParam(h.id, dParamFMax, 0);  // passive until a module drives it
+    h.feedback = detail::newJointFeedback();
     hinge_index_[j.name] = static_cast<int>(hinges_.size());
-    hinges_.push_back(h);
+    hinges_.push_back(std::move(h));
   }
-  for (auto& h : hinges_) dJointSetFeedback(h.id, &h.feedback);  // addresses are stable now
+  for (auto& h : hinges_) dJointSetFeedback(h.id, h.feedback.get());
 }
 
 void Robot::markDriveWheels() {
@@ -293,13 +294,15 @@ void Robot::buildBodyDrive() {
   const Vec3 forward = q * Vec3::UnitX(), left = q * Vec3::UnitY(), up = q * Vec3::UnitZ();
   dJointSetLMotorAxis(drive_linear_, 0, 1, forward.x(), forward.y(), forward.z());
   dJointSetLMotorAxis(drive_linear_, 1, 1, left.x(), left.y(), left.z());
-  dJointSetFeedback(drive_linear_, &drive_linear_fb_);
+  if (!drive_linear_fb_) drive_linear_fb_ = detail::newJointFeedback();
+  dJointSetFeedback(drive_linear_, drive_linear_fb_.get());
   drive_angular_ = dJointCreateAMotor(world_.odeWorld(), nullptr);
   dJointAttach(drive_angular_, chassis, nullptr);
   dJointSetAMotorMode(drive_angular_, dAMotorUser);
   dJointSetAMotorNumAxes(drive_angular_, 1);
   dJointSetAMotorAxis(drive_angular_, 0, 1, up.x(), up.y(), up.z());
-  dJointSetFeedback(drive_angular_, &drive_angular_fb_);
+  if (!drive_angular_fb_) drive_angular_fb_ = detail::newJointFeedback();
+  dJointSetFeedback(drive_angular_, drive_angular_fb_.get());
   dJointSetLMotorParam(drive_linear_, dParamFMax, 0);  // until the first applyCommands
   dJointSetAMotorParam(drive_angular_, dParamFMax, 0);
 }

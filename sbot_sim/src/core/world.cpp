@@ -43,7 +43,8 @@ void initOdeOnce() {
 
 }  // namespace
 
-World::World(const WorldConfig& config) : config_(config) {
+World::World(const WorldConfig& config)
+    : config_(config), wheel_contacts_(std::make_unique<std::deque<WheelContact>>()) {
   initOdeOnce();
   if (!(config_.step > 0)) throw ConfigError("<world>", "step", "must be > 0");
 
@@ -144,6 +145,14 @@ std::vector<Robot*> World::robots() {
   std::vector<Robot*> out;
   for (auto& r : robots_) out.push_back(r.get());
   return out;
+}
+
+void World::setGravity(const Vec3& g) { dWorldSetGravity(world_, g.x(), g.y(), g.z()); }
+
+Vec3 World::gravity() const {
+  dVector3 g;
+  dWorldGetGravity(world_, g);
+  return Vec3(g[0], g[1], g[2]);
 }
 
 void World::enableProfile(bool on) {

@@ -200,9 +200,9 @@ void World::handlePair(dGeomID a, dGeomID b) {
     }
     const bool wheel_a = ia && ia->drive_wheel, wheel_b = ib && ib->drive_wheel;
     if (wheel_a || wheel_b) {
-      wheel_contacts_.push_back({{}, ctx.normal, wheel_a ? ia->robot : nullptr, wheel_b ? ib->robot : nullptr, ba == nullptr,
+      wheel_contacts_->push_back({{}, ctx.normal, wheel_a ? ia->robot : nullptr, wheel_b ? ib->robot : nullptr, ba == nullptr,
                                  wheel_a && ia->track >= 0, wheel_b && ib->track >= 0});
-      dJointSetFeedback(c, &wheel_contacts_.back().feedback);
+      dJointSetFeedback(c, &wheel_contacts_->back().feedback);
     }
   }
 }
@@ -216,14 +216,14 @@ void World::updateDriveWheelLoads() {
     const double push = sign * f.dot(normal);
     if (r && push > 0 && dBodyIsEnabled(r->baseBody())) r->addDriveContact(push, f, wheel);
   };
-  for (const WheelContact& w : wheel_contacts_) {
+  for (const WheelContact& w : *wheel_contacts_) {
     // The contact normal points from geom 2 into geom 1: body 1 is pushed along it, body 2
     // against it. A contact whose body 1 is static is stored reversed by ODE: its body 2's force
     // is reported in f1.
     add(w.wheel_of_body1, w.feedback.f1, 1.0, w.normal, w.on_wheel1);
     add(w.wheel_of_body2, w.body1_static ? w.feedback.f1 : w.feedback.f2, -1.0, w.normal, w.on_wheel2);
   }
-  wheel_contacts_.clear();
+  wheel_contacts_->clear();
 }
 
 }  // namespace sbot

@@ -2,6 +2,7 @@
 // Private to the core: no public header includes it.
 #pragma once
 
+#include <deque>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,15 @@
 #include "sbot_sim/core/world.h"
 
 namespace sbot {
+
+struct World::WheelContact {
+  dJointFeedback feedback{};
+  Vec3 normal = Vec3::UnitZ();
+  Robot* wheel_of_body1 = nullptr;  ///< the robot whose driven wheel is the contact's body 1
+  Robot* wheel_of_body2 = nullptr;
+  bool body1_static = false;        ///< ODE then stores the joint reversed (see updateDriveWheelLoads)
+  bool on_wheel1 = false, on_wheel2 = false;  ///< the geom is a driven wheel itself, not the body drive's chassis
+};
 
 /// The material of static geoms without one of their own, and what the ground plane is made of.
 inline const std::string kGround = "ground";

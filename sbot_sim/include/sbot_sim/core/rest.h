@@ -12,11 +12,10 @@
 // them from waking each other (README, "Sleeping at rest", *Neighbours and groups*).
 #pragma once
 
-#include <ode/ode.h>
-
 #include <limits>
 #include <vector>
 
+#include "sbot_sim/core/detail/ode_handles.h"
 #include "sbot_sim/core/types.h"
 #include "sbot_sim/core/world_config.h"
 
