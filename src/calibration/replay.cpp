@@ -300,7 +300,7 @@ RunPrediction replayDrive(World& world, const RobotDescription& d, const Dataset
       robot.setTrackSpeeds(c.first * su, c.second * su);
     }
     const auto force = run.forceAt(t);
-    if (force.first != 0 || force.second != 0) dBodyAddForce(robot.baseBody(), force.first, force.second, 0);
+    if (force.first != 0 || force.second != 0) robot.addBaseForce(Vec3(force.first, force.second, 0));
     probe.touching = false;
     world.step();
     record((k + 1) * dt, c.first, c.second);
@@ -532,8 +532,8 @@ RunPrediction replayRun(const Dataset& ds, const Run& run, const ModelSpec& mode
     World world(wc);
     if (opt.tilt != 0) {
       const double g = wc.gravity;
-      dWorldSetGravity(world.odeWorld(), g * std::sin(opt.tilt) * std::cos(opt.tilt_direction),
-                       g * std::sin(opt.tilt) * std::sin(opt.tilt_direction), -g * std::cos(opt.tilt));
+      world.setGravity(Vec3(g * std::sin(opt.tilt) * std::cos(opt.tilt_direction),
+                            g * std::sin(opt.tilt) * std::sin(opt.tilt_direction), -g * std::cos(opt.tilt)));
     }
     auto probe = std::make_shared<ContactProbe>();
     world.addEffect(probe);

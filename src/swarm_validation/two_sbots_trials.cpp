@@ -43,7 +43,7 @@ SlopeResult pairSlope(const std::string& level, double angle, int trial, const S
   }
   World w(c);
   const double g = c.gravity;
-  dWorldSetGravity(w.odeWorld(), -g * std::sin(angle), 0, -g * std::cos(angle));
+  w.setGravity(Vec3(-g * std::sin(angle), 0, -g * std::cos(angle)));
   std::mt19937 rng(trial * 131 + static_cast<int>(angle * 1000));
   std::uniform_real_distribution<double> u(-0.02, 0.02);
   const RobotDescription& d = loadLevel(level);

@@ -142,10 +142,7 @@ void holdServos(Robot& r) {
     const auto& L = d.treels.left_joints;
     const auto& R = d.treels.right_joints;
     if (std::find(L.begin(), L.end(), j.name) != L.end() || std::find(R.begin(), R.end(), j.name) != R.end()) continue;
-    dJointID h = r.hingeJoint(j.name);
-    if (!h) continue;
-    dJointSetHingeParam(h, dParamVel, 0);
-    dJointSetHingeParam(h, dParamFMax, j.effort);
+    r.holdJoint(j.name, j.effort);
   }
 }
 
@@ -327,7 +324,7 @@ Outcome slopeHoldClimbTrial(const std::string& level, double angle_rad, bool bac
   World w(c);
   // A tilted gravity is an infinite slope rising toward +x.
   const double g = c.gravity;
-  dWorldSetGravity(w.odeWorld(), -g * std::sin(angle_rad), 0, -g * std::cos(angle_rad));
+  w.setGravity(Vec3(-g * std::sin(angle_rad), 0, -g * std::cos(angle_rad)));
   const double yaw = (backward ? M_PI : 0.0) + j.uniform(-0.03, 0.03);
   Robot& r = spawn(w, d, {0, 0, yaw});
   r.setSpeed(0, 0);
@@ -613,7 +610,7 @@ StepCost profileTrial(const std::string& level, double sim_seconds) {
   c.feedback = p.feedback_s / wall;
   c.sensors = sensing / wall;
   c.contacts_per_step = static_cast<double>(p.contacts) / static_cast<double>(p.steps);
-  c.bodies = static_cast<int>(r.bodies().size());
+  c.bodies = static_cast<int>(r.bodyCount());
   c.iterations = w.solverIterations();
   c.step_s = w.config().step;
   return c;
@@ -919,21 +916,6 @@ namespace validation {
 
 namespace {
 
-/// Whole-robot centre of mass in world coordinates, and the mass [kg].
-Vec3 centreOfMass(const Robot& r, double* mass_out) {
-  double m = 0;
-  Vec3 com = Vec3::Zero();
-  for (dBodyID b : r.bodies()) {
-    dMass mass;
-    dBodyGetMass(b, &mass);
-    const dReal* p = dBodyGetPosition(b);
-    com += mass.mass * Vec3(p[0], p[1], p[2]);
-    m += mass.mass;
-  }
-  if (mass_out) *mass_out = m;
-  return com / m;
-}
-
 /// A robot of `level` resting on flat ground for 2 s (the model facts' set-up).
 struct RestingRobot {
   const RobotDescription& d;
@@ -975,7 +957,7 @@ SideView sideView(const std::string& level) {
     if (j->parent != d.root_link)
       throw ConfigError(d.urdf_path, j->name, "a wheel hinge on '" + j->parent + "', expected one on " + d.root_link);
   const Vec3 c = centre->origin.position, f = front->origin.position;
-  const Vec3 com = rest.r.basePose().inverse().transform(centreOfMass(rest.r, nullptr));
+  const Vec3 com = rest.r.basePose().inverse().transform(rest.r.centreOfMass());
   SideView s;
   s.centre_radius = d.wheelRadius(centre->name);
   s.front_radius = d.wheelRadius(front->name);
@@ -998,12 +980,12 @@ std::string restFacts(const std::string& level) {
   RestingRobot rest(level);
   Robot& r = rest.r;
   double m = 0;
-  const Vec3 com = centreOfMass(r, &m);
+  const Vec3 com = r.centreOfMass(&m);
   const Pose base = r.basePose();
   const Vec3 com_b = base.inverse().transform(com);
   const Vec3 rpy = rpyFromQuat(base.orientation);
   std::ostringstream s;
-  s << level << ": mass " << m << " kg, bodies " << r.bodies().size()
+  s << level << ": mass " << m << " kg, bodies " << r.bodyCount()
     << (r.turretLocked() ? " (turret welded to the treels while idle)" : "") << ", COM in base frame (" << com_b.x() << ", "
     << com_b.y() << ", " << com_b.z() << ") m, COM height above ground " << com.z() << " m, base height "
     << base.position.z() << " m, rest roll " << rpy.x() * 180 / M_PI << " deg pitch " << rpy.y() * 180 / M_PI
@@ -1028,7 +1010,7 @@ Outcome tippingAngle(const std::string& level, bool backward, int iterations) {
   const std::size_t window = static_cast<std::size_t>(std::lround(1.0 / c.step)) + 1;
   for (double t = 0; t < 90 / kRate; t += c.step) {
     const double a = kRate * t * M_PI / 180;
-    dWorldSetGravity(w.odeWorld(), -c.gravity * std::sin(a), 0, -c.gravity * std::cos(a));
+    w.setGravity(Vec3(-c.gravity * std::sin(a), 0, -c.gravity * std::cos(a)));
     w.step();
     // Sliding: 1 cm (scaled) in the last second with the attitude unchanged (within 2 deg: not
     // the start of a tip). Creep is ~1 mm/s; the instantaneous velocity carries quickstep's jitter.

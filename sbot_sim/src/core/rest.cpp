@@ -1,5 +1,7 @@
 #include "sbot_sim/core/rest.h"
 
+#include <ode/ode.h>
+
 namespace sbot {
 namespace {
 

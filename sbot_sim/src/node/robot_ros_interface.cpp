@@ -172,12 +172,7 @@ void RobotRosInterface::publishState(const ros::Time& stamp,
     odom.child_frame_id = base_frame_;
     odom.pose.pose.position = toPoint(base.position);
     odom.pose.pose.orientation = toQuaternion(base.orientation);
-    sbot::Vec3 v_world = r.linearVelocity();
-    if (dBodyID body = r.baseBody()) {
-      dVector3 pv;
-      dBodyGetPointVel(body, base.position.x(), base.position.y(), base.position.z(), pv);
-      v_world = sbot::Vec3(pv[0], pv[1], pv[2]);
-    }
+    const sbot::Vec3 v_world = r.linearVelocity();
     const sbot::Quat q_inv = base.orientation.conjugate();
     odom.twist.twist.linear = toVector3(q_inv * v_world);
     odom.twist.twist.angular = toVector3(q_inv * r.angularVelocity());

@@ -2,6 +2,8 @@
 // connection registry, and the optical barrier.
 #include <gtest/gtest.h>
 
+#include <ode/ode.h>
+
 #include <algorithm>
 
 #include <cmath>

@@ -1,6 +1,8 @@
 // Side arm (seed 2.2.4, Table 2.5): inverse kinematics, ranges, availability, servo motion.
 #include <gtest/gtest.h>
 
+#include <ode/ode.h>
+
 #include <cmath>
 
 #include "sbot_sim/core/actuators/side_arm.h"

@@ -2,6 +2,8 @@
 // off, and each drive effect doing what its description says in the simulator.
 #include <gtest/gtest.h>
 
+#include <ode/ode.h>
+
 #include <cmath>
 
 #include "sbot_sim/core/effects/drive_effects.h"

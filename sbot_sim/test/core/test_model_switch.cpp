@@ -2,6 +2,8 @@
 // switched mid-run continues its trajectory, levels round-trip, connections survive a switch.
 #include <gtest/gtest.h>
 
+#include <ode/ode.h>
+
 #include <cmath>
 
 #include "sbot_sim/core/errors.h"

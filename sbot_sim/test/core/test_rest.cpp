@@ -2,6 +2,8 @@
 // move them still does.
 #include <gtest/gtest.h>
 
+#include <ode/ode.h>
+
 #include <algorithm>
 #include <cmath>
 #include <map>

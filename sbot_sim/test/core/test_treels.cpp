@@ -2,6 +2,8 @@
 // stalling against a wall, the acceleration phase, API clamping.
 #include <gtest/gtest.h>
 
+#include <ode/ode.h>
+
 #include <algorithm>
 
 #include <cmath>

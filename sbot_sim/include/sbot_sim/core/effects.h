@@ -11,8 +11,7 @@
 #include <string>
 #include <vector>
 
-#include <ode/ode.h>
-
+#include "sbot_sim/core/detail/ode_handles.h"
 #include "sbot_sim/core/types.h"
 
 namespace sbot {

@@ -12,11 +12,10 @@
 // them from waking each other (docs/model.md, "Sleeping at rest").
 #pragma once
 
-#include <ode/ode.h>
-
 #include <limits>
 #include <vector>
 
+#include "sbot_sim/core/detail/ode_handles.h"
 #include "sbot_sim/core/types.h"
 #include "sbot_sim/core/world_config.h"
 

@@ -9,8 +9,7 @@
 #include <string>
 #include <vector>
 
-#include <ode/ode.h>
-
+#include "sbot_sim/core/detail/ode_handles.h"
 #include "sbot_sim/core/effects.h"
 #include "sbot_sim/core/geom_info.h"
 #include "sbot_sim/core/link_ref.h"
@@ -120,9 +119,15 @@ class Robot {
   bool hasLink(const std::string& link) const { return link_index_.count(link) != 0; }
   /// hasLink through a LinkRef: its absence, like its frame, is looked up once per build.
   bool hasLink(const LinkRef& link) const { return resolve(link); }
-  Vec3 linearVelocity() const;   ///< of base_link's body, world frame [m/s]
+  Vec3 linearVelocity() const;   ///< of the base_link origin, world frame [m/s]
   Vec3 angularVelocity() const;  ///< world frame [rad/s]
   std::vector<JointState> jointStates() const;
+  /// The whole robot's centre of mass [m, world frame]; its mass [kg] into `mass_out` if given.
+  Vec3 centreOfMass(double* mass_out = nullptr) const;
+  /// Rigid bodies the model is built of (links joined by fixed joints are one body).
+  std::size_t bodyCount() const { return bodies_.size(); }
+  /// Push the robot: `force` [N, world frame] at its base body's centre of mass, for the next step.
+  void addBaseForce(const Vec3& force);
 
   /// Move the robot so base_link sits at `pose` with zero velocity (teleport).
   void setBasePose(const Pose& pose);
@@ -143,6 +148,9 @@ class Robot {
   double jointAngle(const std::string& joint) const;
   double jointRate(const std::string& joint) const;
   double jointEffort(const std::string& joint) const;
+  /// Hold hinge `joint` where it is, as a powered servo does: its motor's target rate 0, with at
+  /// most `max_torque` [N m]. False (and nothing done) if the level has no such joint.
+  bool holdJoint(const std::string& joint, double max_torque);
   /// ODE body carrying a URDF link (massless links are merged into a body); nullptr if absent.
   dBodyID linkBody(const std::string& link) const;
 
@@ -227,7 +235,7 @@ class Robot {
   struct Hinge {
     std::string name;
     dJointID id = nullptr;
-    dJointFeedback feedback{};
+    detail::JointFeedbackPtr feedback;  ///< ODE writes the hinge's forces here each step
     Vec3 axis_in_child = Vec3::UnitZ();
     int child_body = -1;
     double effort = 0;      ///< torque about the axis, last step [N m]
@@ -235,8 +243,15 @@ class Robot {
     double raw_angle = 0;   ///< ODE's wrapped angle at the last update
   };
 
-  /// Builds from model_ (the level's description, or its copy with the turret welded).
+  /// Builds from model_ (the level's description, or its copy with the turret welded): the stages
+  /// below, in robot_build.cpp.
   void build(const Pose& base_pose);
+  struct LinkGroups;  ///< links grouped into rigid bodies (a fixed joint merges a child into its parent)
+  static LinkGroups groupLinks(const RobotDescription& d, const Pose& base_pose);
+  /// The body of group `gi` (its mass about its centre of mass) with its links' collision geoms.
+  void addGroupBody(const LinkGroups& groups, std::size_t gi, double inertia_floor);
+  void addHinges(const LinkGroups& groups);  ///< one ODE hinge per moving joint
+  void markDriveWheels();                    ///< the tracks' hinges and their wheels' geoms
   /// switchDescription's work: rebuild from `model` in place, carrying the state over
   /// (core/swarm/model_switch.cpp). description_ is already the level to be.
   void rebuild(const RobotDescription& model);
@@ -321,7 +336,8 @@ class Robot {
   // chassis, casters and wheels onto their support in the last step: none while airborne).
   dJointID drive_linear_ = nullptr;   ///< LMotor, axes chassis x and y
   dJointID drive_angular_ = nullptr;  ///< AMotor, axis chassis z
-  dJointFeedback drive_linear_fb_{}, drive_angular_fb_{};
+  /// The motors' forces (kept across rebuilds: the first step after one reads the last step's).
+  detail::JointFeedbackPtr drive_linear_fb_, drive_angular_fb_;
   double drive_torque_[2] = {0, 0};   ///< [N m] per track (left, right), last step
   double drive_traction_ = 0;         ///< [N] see bodyDriveTraction()
   // Per-step track torques of the last treels.torque_window (ring buffer) and their running sum.

@@ -7,9 +7,8 @@
 #include <string>
 #include <vector>
 
-#include <ode/ode.h>
-
 #include "sbot_sim/core/actuators/connections.h"
+#include "sbot_sim/core/detail/ode_handles.h"
 #include "sbot_sim/core/effects.h"
 #include "sbot_sim/core/robot.h"
 #include "sbot_sim/core/world_config.h"
@@ -81,6 +80,10 @@ class World {
   void step();
   void stepN(int n) { for (int i = 0; i < n; ++i) step(); }
   double time() const { return time_; }
+  /// Gravity [m/s^2, world frame]; the config's is (0, 0, -gravity). A slope experiment tilts it;
+  /// a new gravity wakes every sleeping robot at the next step.
+  void setGravity(const Vec3& g);
+  Vec3 gravity() const;
   std::uint64_t stepCount() const { return steps_; }
   const WorldConfig& config() const { return config_; }
 
@@ -154,7 +157,7 @@ class World {
   /// meet its segment's; collideWithTerrain a robot only against the static geoms that meet its own.
   struct BoxedGeom {
     dGeomID geom;
-    dReal aabb[6];
+    double aabb[6];  ///< ODE's dReal (double: ode_handles.cpp checks)
   };
   // internal: collision callback trampoline
   void handlePair(dGeomID a, dGeomID b);
@@ -164,7 +167,7 @@ class World {
   std::vector<BoxedGeom> terrain_index_;        ///< static_space_'s geoms, in its order (never move)
   std::vector<BoxedGeom> robot_geoms_;          ///< collideWithTerrain's robot geoms (reused)
   void indexTerrain();  ///< fills terrain_index_ (after buildTerrain)
-  /// Contacts between a robot and the terrain (see world.cpp for why not dSpaceCollide2).
+  /// Contacts between a robot and the terrain (see world_contacts.cpp for why not dSpaceCollide2).
   void collideWithTerrain(Robot& r);
   /// Before the terrain is collided: wake every sleeping robot that a joint (a contact made this
   /// step, a connection, a static link) ties to an awake body, as ODE's island walk would mid-step.
@@ -201,7 +204,7 @@ class World {
   /// the box around each run (reused).
   struct CandidateGroup {
     std::size_t begin, end;
-    dReal aabb[6];
+    double aabb[6];
   };
   mutable std::vector<CandidateGroup> candidate_groups_;
   int solver_iterations_ = 0;
@@ -219,17 +222,11 @@ class World {
   void castAgainstCandidates(const Vec3& origin, const Vec3* directions, std::size_t n, double length,
                              const Robot* ignore, RayHit* hits) const;
   dJointGroupID contacts_ = nullptr;
-  /// This step's contacts on driven treels wheels, with ODE's force feedback (Robot::driveWheelLoad).
-  /// A deque: ODE keeps pointers to the feedback records while the step runs.
-  struct WheelContact {
-    dJointFeedback feedback{};
-    Vec3 normal = Vec3::UnitZ();
-    Robot* wheel_of_body1 = nullptr;  ///< the robot whose driven wheel is the contact's body 1
-    Robot* wheel_of_body2 = nullptr;
-    bool body1_static = false;        ///< ODE then stores the joint reversed (see updateDriveWheelLoads)
-    bool on_wheel1 = false, on_wheel2 = false;  ///< the geom is a driven wheel itself, not the body drive's chassis
-  };
-  std::deque<WheelContact> wheel_contacts_;
+  /// This step's contacts on driven treels wheels, with ODE's force feedback (Robot::driveWheelLoad;
+  /// defined in world_internal.h). A deque: ODE keeps pointers to the feedback records while the
+  /// step runs.
+  struct WheelContact;
+  std::unique_ptr<std::deque<WheelContact>> wheel_contacts_;
   void updateDriveWheelLoads();       ///< after the step: sum the normal forces per robot
   std::vector<dGeomID> static_geoms_;
   std::map<dGeomID, std::string> static_material_;

@@ -1,5 +1,7 @@
 #include "sbot_sim/core/actuators/gripper.h"
 
+#include <ode/ode.h>
+
 #include <algorithm>
 #include <cmath>
 

@@ -1,5 +1,7 @@
 #include "sbot_sim/core/effects/drive_effects.h"
 
+#include <ode/ode.h>
+
 #include <algorithm>
 #include <cmath>
 #include <utility>

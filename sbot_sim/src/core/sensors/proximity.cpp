@@ -1,5 +1,7 @@
 #include "sbot_sim/core/sensors/proximity.h"
 
+#include <ode/ode.h>
+
 #include <algorithm>
 #include <cmath>
 #include <iomanip>

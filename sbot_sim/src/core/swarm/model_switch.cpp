@@ -24,6 +24,8 @@
 // Not carried: joint motor states of modules (the gripper / side-arm modules re-apply their targets
 // every step) and anything a module cached from the old bodies.
 #include <cmath>
+
+#include <ode/ode.h>
 #include <map>
 #include <set>
 

@@ -1,5 +1,7 @@
 #include "sbot_sim/core/swarm/swarm_graph.h"
 
+#include <ode/ode.h>
+
 #include <algorithm>
 #include <cmath>
 #include <map>

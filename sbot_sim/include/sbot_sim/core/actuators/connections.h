@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include <ode/ode.h>
+#include "sbot_sim/core/detail/ode_handles.h"
 
 namespace sbot {
 
