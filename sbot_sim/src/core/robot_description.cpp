@@ -16,6 +16,8 @@
 
 #include "sbot_sim/core/yaml_checks.h"
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/input_file.h"
+#include "sbot_sim/core/input_limits.h"
 #include "sbot_sim/core/world_config.h"
 
 #ifndef SBOT_DESCRIPTION_SOURCE_DIR
@@ -29,14 +31,6 @@ Pose toPose(const urdf::Pose& p) {
   double x, y, z, w;
   p.rotation.getQuaternion(x, y, z, w);
   return Pose(Vec3(p.position.x, p.position.y, p.position.z), Quat(w, x, y, z).normalized());
-}
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path, "", "cannot open file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 /// The XML of `<link name="NAME" ...>` up to its end, comments removed ("" if not found).
@@ -79,6 +73,11 @@ constexpr double kMaxInertia = 1000;   ///< [kg m^2] per inertia entry
 
 void requirePositive(double v, const std::string& file, const std::string& field) {
   if (!(std::isfinite(v) && v > 0)) throw ConfigError(file, field, "must be a finite number > 0");
+}
+
+/// A shape's edge, radius or length: degenerate geometry is refused here, not by an ODE assertion.
+void requireGeomSize(double v, const std::string& file, const std::string& field) {
+  if (const std::string problem = geomSizeProblem(v); !problem.empty()) throw ConfigError(file, field, problem);
 }
 
 void requireAtMost(double v, double limit, const std::string& file, const std::string& field, const char* unit) {
@@ -140,7 +139,7 @@ LinkDescription convertLink(const urdf::Link& link, const std::string& xml, cons
       case urdf::Geometry::SPHERE:
         shape.type = CollisionShape::Type::Sphere;
         shape.radius = static_cast<const urdf::Sphere&>(*col->geometry).radius;
-        requirePositive(shape.radius, file, field + "/sphere radius");
+        requireGeomSize(shape.radius, file, field + "/sphere radius");
         requireAtMost(shape.radius, kMaxLength, file, field + "/sphere radius", "m");
         break;
       case urdf::Geometry::CYLINDER: {
@@ -148,8 +147,8 @@ LinkDescription convertLink(const urdf::Link& link, const std::string& xml, cons
         shape.type = CollisionShape::Type::Cylinder;
         shape.radius = c.radius;
         shape.length = c.length;
-        requirePositive(shape.radius, file, field + "/cylinder radius");
-        requirePositive(shape.length, file, field + "/cylinder length");
+        requireGeomSize(shape.radius, file, field + "/cylinder radius");
+        requireGeomSize(shape.length, file, field + "/cylinder length");
         requireAtMost(std::max(shape.radius, shape.length), kMaxLength, file, field + "/cylinder", "m");
         break;
       }
@@ -157,7 +156,7 @@ LinkDescription convertLink(const urdf::Link& link, const std::string& xml, cons
         const auto& b = static_cast<const urdf::Box&>(*col->geometry);
         shape.type = CollisionShape::Type::Box;
         shape.size = Vec3(b.dim.x, b.dim.y, b.dim.z);
-        for (int k = 0; k < 3; ++k) requirePositive(shape.size[k], file, field + "/box size");
+        for (int k = 0; k < 3; ++k) requireGeomSize(shape.size[k], file, field + "/box size");
         for (int k = 0; k < 3; ++k) requireAtMost(shape.size[k], kMaxLength, file, field + "/box size", "m");
         break;
       }
@@ -376,9 +375,7 @@ void parseSidecar(RobotDescription& d) {
   const std::string& file = d.sidecar_path;
   YAML::Node root;
   try {
-    root = YAML::LoadFile(file);
-  } catch (const YAML::BadFile&) {
-    throw ConfigError(file, "", "cannot open sidecar file");
+    root = YAML::Load(readInputFile(file, "sidecar file"));
   } catch (const YAML::Exception& e) {
     throw ConfigError(file, "", std::string("not valid YAML: ") + e.what());
   }
@@ -650,7 +647,7 @@ RobotDescription loadRobotDescription(const std::string& urdf_path, const std::s
   RobotDescription d;
   d.urdf_path = urdf_path;
   d.sidecar_path = sidecar_path;
-  d.urdf_xml = readFile(urdf_path);
+  d.urdf_xml = readInputFile(urdf_path);
   urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(d.urdf_xml);
   if (!model) throw ConfigError(urdf_path, "", "not a valid URDF (urdfdom's message is printed above)");
   if (!model->getRoot()) throw ConfigError(urdf_path, "", "URDF has no root link");

@@ -355,11 +355,11 @@ links: [{holder: holder, held: held, kind: side_arm}]
 TEST(Scenario, LampsAndAmbientLightAreCheckedByField) {
   refused("world: {ambient_light: .inf}", "'world.ambient_light': must be finite");
   refused("world: {ambient_light: .nan}", "'world.ambient_light': must be finite");
-  refused("world: {ambient_light: -100}", "'world.ambient_light': must be >= 0");
+  refused("world: {ambient_light: -100}", "'world.ambient_light': must be in [0, 1e+09] mcd/cm^2, found -100");
   refused("world: {ambient_light: bright}", "'world.ambient_light': expected a number, found 'bright'");
   const std::string ok = "{position: [0, 0, 1], intensity: 10}";
   refused("world: {lamps: [" + ok + ", {position: [0, 0, 1], intensity: .nan}]}", "'world.lamps[1].intensity': must be finite");
-  refused("world: {lamps: [{position: [0, 0, 1], intensity: -1}]}", "'world.lamps[0].intensity': must be >= 0");
+  refused("world: {lamps: [{position: [0, 0, 1], intensity: -1}]}", "'world.lamps[0].intensity': must be in [0, 1e+09] mcd, found -1");
   refused("world: {lamps: [{position: [0.8], intensity: 1}]}", "'world.lamps[0].position': expected [x, y, z]");
   refused("world: {lamps: [{intensity: 1}]}", "'world.lamps[0].position': missing");
   refused("world: {lamps: [{position: [1e9, 0, 1]}]}", "'world.lamps[0].position'");
