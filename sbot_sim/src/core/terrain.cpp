@@ -64,7 +64,7 @@ HeightMap makeHeightMap(const TerrainConfig& t) {
   map.size_y = t.size_y;
   std::vector<double> raw;
   if (!t.heightmap_image.empty()) {
-    if (const std::string problem = inputFileProblem(t.heightmap_image); !problem.empty())
+    if (const std::string problem = inputFileProblem(t.heightmap_image, "image"); !problem.empty())
       throw ConfigError(t.heightmap_image, "terrain.heightmap_image", problem);
     cv::Mat img = cv::imread(t.heightmap_image, cv::IMREAD_GRAYSCALE);
     if (img.empty()) throw ConfigError(t.heightmap_image, "terrain.heightmap_image", "cannot read image");
