@@ -123,6 +123,17 @@ def wait_until(condition, timeout, what):
 
 
 class LockstepRepeatable(unittest.TestCase):
+    def running_controller(self, launch, namespace):
+        """The pid of the launch's controller in `namespace`, once it has started, joined and run."""
+        deadline = time.monotonic() + 30
+        pid = None
+        while pid is None and time.monotonic() < deadline:
+            pid = controller_pid(namespace, launch.pid)
+            time.sleep(0.1)
+        self.assertIsNotNone(pid, "no sbot_phototaxis process in " + namespace)
+        time.sleep(4.0)  # started, joined, running
+        return pid
+
     def test_two_lockstep_runs_agree(self):
         with tempfile.TemporaryDirectory() as d:
             a, summary_a = run_once(d, "a")
@@ -147,13 +158,7 @@ class LockstepRepeatable(unittest.TestCase):
         launch = launch_phototaxis(env, "lockstep:=true", "lockstep_timeout:=1", "duration:=10",
                                    "real_time_factor:=2")
         try:
-            deadline = time.monotonic() + 30
-            pid = None
-            while pid is None and time.monotonic() < deadline:
-                pid = controller_pid("/sbot_2", launch.pid)
-                time.sleep(0.1)
-            self.assertIsNotNone(pid, "no sbot_phototaxis process in /sbot_2")
-            time.sleep(4.0)  # started, joined, running
+            pid = self.running_controller(launch, "/sbot_2")
             os.kill(pid, signal.SIGSTOP)
             time.sleep(3.0)  # > ~lockstep_timeout: dropped by now
             os.kill(pid, signal.SIGKILL)
@@ -178,13 +183,7 @@ class LockstepRepeatable(unittest.TestCase):
         recorder = subprocess.Popen(["rosbag", "record", "-q", "-e", "/sbot_2/.*", "-O", os.path.join(workdir, "r.bag")],
                                     env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
         try:
-            deadline = time.monotonic() + 30
-            pid = None
-            while pid is None and time.monotonic() < deadline:
-                pid = controller_pid("/sbot_2", launch.pid)
-                time.sleep(0.1)
-            self.assertIsNotNone(pid, "no sbot_phototaxis process in /sbot_2")
-            time.sleep(4.0)  # started, joined, running
+            pid = self.running_controller(launch, "/sbot_2")
             killed_at = time.time()
             os.kill(pid, signal.SIGKILL)
             out, _ = launch.communicate(timeout=60)
