@@ -24,6 +24,10 @@
 // For every robot count it runs, in a fresh child process (so peak memory is that run's own), a
 // swarm doing a random walk on a flat arena, and prints the real-time multiplier RTM (simulated s
 // per wall s), the wall time per step and the peak resident memory.
+//
+// Exit status (sbot_sim/tools/cli_args.h): 2 when an option or the scenario is refused, before the
+// table header (every robot the file lists is checked, and every world a row will build is built
+// once, in a child); 1 when a row's run fails; 3 when a row's run crashed (killed by a signal, named).
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -276,13 +280,24 @@ int main(int argc, char** argv) {
     std::printf("sbot_bench: headless core, flat arena, %s%s, 1 core per run\n", o.idle ? "idle" : "random walk",
                 o.sensors ? ", sensors" : "");
   } else {
-    // Read here, before any row, so that a malformed file (or a count it cannot take) is refused once.
-    try {
-      for (int n : o.robots) sbot::loadScenario(o.scenario, n);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "sbot_bench: --scenario: %s\n", e.what());
-      return 2;
+    // Checked here, before any row, so that a malformed file (or a count it cannot take) is refused
+    // once with exit status 2: every robot the file lists (also those a --robots count leaves out),
+    // and every world a row will build, built in a child so that the rows' peak memory stays their own.
+    const pid_t pid = fork();
+    if (pid == 0) {
+      try {
+        sbot::loadScenario(o.scenario, -1);
+        for (int n : o.robots) sbot::buildScenarioWorld(sbot::loadScenario(o.scenario, n));
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "sbot_bench: --scenario: %s\n", e.what());
+        std::_Exit(sbot_tools::kExitBadInput);
+      }
+      std::_Exit(0);
     }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    if (WIFEXITED(status) && WEXITSTATUS(status) == sbot_tools::kExitBadInput) return sbot_tools::kExitBadInput;
+    if (const int outcome = sbot_tools::workerOutcome("sbot_bench", "checking the scenario", status)) return outcome;
     std::printf("sbot_bench: headless core, scenario %s, %s, 1 core per run\n", o.scenario.c_str(),
                 o.idle ? "idle" : "random walk");
   }
@@ -290,7 +305,7 @@ int main(int argc, char** argv) {
   std::printf("sbot_bench: machine: %s\n", sbot_tools::describeThisMachine().c_str());
   std::printf("%-8s %7s %10s %12s %14s %12s\n", "level", "robots", "sim_s", "RTM", "wall_ms/step", "peak_MiB");
   std::fflush(stdout);
-  int failures = 0;
+  int exit_status = sbot_tools::kExitDone;
   for (int n : o.robots) {
     const pid_t pid = fork();
     if (pid == 0) {
@@ -298,17 +313,17 @@ int main(int argc, char** argv) {
         runOne(o, n);
       } catch (const std::exception& e) {
         std::fprintf(stderr, "sbot_bench: %s\n", e.what());
-        std::_Exit(1);
+        std::_Exit(sbot_tools::kExitFailure);
       }
       std::_Exit(0);
     }
     int status = 0;
     waitpid(pid, &status, 0);
-    // A run that dies (ODE aborts on an internal error) must not leave its row silently missing.
-    if (WIFSIGNALED(status))
-      std::fprintf(stderr, "sbot_bench: the run with %d robots was killed by signal %d (%s); no row for it\n", n,
-                   WTERMSIG(status), strsignal(WTERMSIG(status)));
-    failures += !(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    // A run that dies must not leave its row silently missing.
+    const std::string what = n < 0 ? std::string("the run of the scenario's robots") : "the run with " + std::to_string(n) + " robots";
+    const int outcome = sbot_tools::workerOutcome("sbot_bench", what, status);
+    if (outcome != sbot_tools::kExitDone) std::fprintf(stderr, "sbot_bench: no row for %s\n", what.c_str());
+    exit_status = sbot_tools::worseExit(exit_status, outcome);
   }
-  return failures == 0 ? 0 : 1;
+  return exit_status;
 }

@@ -18,6 +18,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/input_file.h"
 #include "sbot_sim/core/output_files.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/scenario.h"
@@ -74,18 +75,16 @@ NonTextByte firstNonTextByte(const std::string& text) {
 bool isDirectory(const std::string& p);
 
 std::string readFile(const std::string& path, const std::string& referrer, const YAML::Node& where) {
-  if (isDirectory(path)) {  // it opens as a stream that reads nothing: "empty file"
-    if (referrer.empty()) throw DatasetError(path, 0, 0, "", "is a folder, not a file");
-    fail(referrer, where, "", "'" + path + "' is a folder, not a file");
+  // Not a regular file (a folder, /dev/zero, a FIFO), too large, or unreadable: sbot/core/input_file.h.
+  if (const std::string problem = inputFileProblem(path); !problem.empty()) {
+    if (referrer.empty()) throw DatasetError(path, 0, 0, "", problem);
+    fail(referrer, where, "", "'" + path + "' " + problem);
   }
-  std::ifstream in(path);
-  if (!in) {
-    if (referrer.empty()) throw DatasetError(path, 0, 0, "", "cannot open file");
-    fail(referrer, where, "", "cannot open file '" + path + "'");
+  try {
+    return readInputFile(path);
+  } catch (const ConfigError& e) {
+    throw DatasetError(path, 0, 0, "", e.what());
   }
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 bool isDirectory(const std::string& p) {

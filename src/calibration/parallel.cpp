@@ -187,11 +187,16 @@ std::vector<std::string> WorkerPool::mapBytes(std::size_t n, const std::function
     }
   }
   bool crashed = false;
+  std::string signalled;  // the first worker killed by a signal, named
   for (int p = 0; p < procs; ++p) {
     int status = 0;
     ::waitpid(pids[p], &status, 0);
     crashed |= !(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    if (WIFSIGNALED(status) && signalled.empty())
+      signalled = "a worker process crashed: killed by signal " + std::to_string(WTERMSIG(status)) + " (" +
+                  strsignal(WTERMSIG(status)) + ")";
   }
+  if (!signalled.empty()) throw WorkerCrashed(signalled);
   if (!first_error.empty()) throw std::runtime_error(first_error);
   for (std::size_t i = 0; i < n; ++i)
     if (!got[i]) throw std::runtime_error(std::string("a worker process died") + (crashed ? " (crash)" : ""));

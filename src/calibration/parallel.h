@@ -10,12 +10,19 @@
 #pragma once
 
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "calibration/serialize.h"
 
 namespace sbot::calib {
+
+/// A worker process of WorkerPool::map ended by a signal (what() names it): a crash, not a refusal.
+class WorkerCrashed : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 class WorkerPool {
  public:

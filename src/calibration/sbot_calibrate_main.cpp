@@ -38,12 +38,14 @@
 #include "calibration/diagnose.h"
 #include "calibration/effect_list.h"
 #include "calibration/generator.h"
+#include "calibration/parallel.h"
 #include "calibration/report.h"
 #include "calibration/sweep.h"
 #include "sbot_sim/core/effects/effect_registry.h"
 #include "sbot_sim/core/errors.h"
 #include "sbot_sim/core/output_files.h"
 #include "sbot_sim/core/robot_description.h"
+#include "sbot_sim/tools/cli_args.h"
 
 using namespace sbot;
 using namespace sbot::calib;
@@ -227,6 +229,12 @@ void probeWrite(const std::string& path, bool directory) {
   if (!created.empty()) ::unlink(created.c_str());
 }
 
+/// An output place refused before the work (exit status 2), unlike a write that fails during it.
+class OutputPlaceRefused : public OutputError {
+ public:
+  using OutputError::OutputError;
+};
+
 /// The output place `path` of `--option` (a folder, or a file) exists (folders created) and can be
 /// written (output_files.h, then probeWrite); else an OutputError that names the option, with the
 /// folders this check created removed again.
@@ -238,7 +246,7 @@ void checkOutputPlace(const std::string& option, const std::string& path, bool d
     probeWrite(path, directory);
   } catch (const OutputError& e) {
     for (auto it = missing.rbegin(); it != missing.rend(); ++it) ::rmdir(it->c_str());
-    throw OutputError("--" + option + ": " + e.what());
+    throw OutputPlaceRefused("--" + option + ": " + e.what());
   }
   g_created_dirs.insert(g_created_dirs.end(), missing.begin(), missing.end());
 }
@@ -253,7 +261,7 @@ void refuseDatasetFile(const std::string& option, const std::string& path, const
   for (const std::string& input : inputs) {
     char in[PATH_MAX];
     if (::realpath(input.c_str(), in) && std::strcmp(in, out) == 0)
-      throw OutputError("--" + option + ": '" + path + "' is the dataset's own " + input +
+      throw OutputPlaceRefused("--" + option + ": '" + path + "' is the dataset's own " + input +
                         "; write the result elsewhere (the dataset is the measurement)");
   }
 }
@@ -703,6 +711,12 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     removeCreatedDirs();  // a refused or failed run leaves no empty folder behind
     std::fprintf(stderr, "sbot_calibrate: %s\n", e.what());
-    return 1;
+    // Exit statuses as every tool's (sbot_sim/tools/cli_args.h): 2 a refused option, output place or
+    // input file (all checked before the work), 3 a crashed worker, 1 any other failure.
+    if (dynamic_cast<const WorkerCrashed*>(&e)) return sbot_tools::kExitCrash;
+    if (dynamic_cast<const std::invalid_argument*>(&e) || dynamic_cast<const OutputPlaceRefused*>(&e) ||
+        dynamic_cast<const sbot::ConfigError*>(&e))
+      return sbot_tools::kExitBadInput;
+    return sbot_tools::kExitFailure;
   }
 }

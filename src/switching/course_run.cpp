@@ -11,6 +11,8 @@
 #include <yaml-cpp/yaml.h>
 
 #include "sbot_sim/core/actuators/gripper.h"
+#include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/input_file.h"
 #include "sbot_sim/core/output_files.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/swarm/level_policy.h"
@@ -35,9 +37,9 @@ Route loadRoute(const std::string& path) {
   };
   YAML::Node n;
   try {
-    n = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    refuse("", "cannot open route file");
+    n = YAML::Load(sbot::readInputFile(path, "route file"));
+  } catch (const sbot::ConfigError& e) {
+    refuse("", e.what());
   } catch (const YAML::Exception& e) {
     refuse("", "not valid YAML (line " + std::to_string(e.mark.line + 1) + "): " + e.msg);
   }

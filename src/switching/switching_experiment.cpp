@@ -169,13 +169,20 @@ int main(int argc, char** argv) {
     loadRoute(o.route);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "switching_experiment: %s\n", e.what());
-    return 1;
+    return sbot_tools::kExitBadInput;
   }
-  // One child process per mode; at most `jobs` at a time.
-  std::vector<pid_t> running;
+  // One child process per mode; at most `jobs` at a time. Exit statuses: sbot_sim/tools/cli_args.h.
+  std::vector<std::pair<pid_t, std::string>> running;
+  int exit_status = sbot_tools::kExitDone;
+  const auto wait_for = [&](const std::pair<pid_t, std::string>& run) {
+    int status = 0;
+    waitpid(run.first, &status, 0);
+    exit_status = sbot_tools::worseExit(
+        exit_status, sbot_tools::workerOutcome("switching_experiment", "the run of mode " + run.second, status));
+  };
   for (const auto& mode : o.modes) {
     if (static_cast<int>(running.size()) >= std::max(1, o.jobs)) {
-      waitpid(running.front(), nullptr, 0);
+      wait_for(running.front());
       running.erase(running.begin());
     }
     const pid_t pid = fork();
@@ -188,15 +195,10 @@ int main(int argc, char** argv) {
       }
       _exit(0);
     }
-    running.push_back(pid);
+    running.emplace_back(pid, mode);
   }
-  int failed = 0;
-  for (pid_t p : running) {
-    int status = 0;
-    waitpid(p, &status, 0);
-    failed += !(WIFEXITED(status) && WEXITSTATUS(status) == 0);
-  }
-  if (failed) return 1;
+  for (const auto& run : running) wait_for(run);
+  if (exit_status != sbot_tools::kExitDone) return exit_status;
 
   std::ostringstream rep;
   std::map<std::string, ModeStats> st;

@@ -9,20 +9,20 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "sbot_sim/core/input_file.h"
 #include "sbot_sim/core/yaml_checks.h"
 
 namespace sbot {
 namespace validation {
 
-/// The parsed file; throws std::runtime_error("<what> <path>: cannot be read" / ": not YAML (...)").
+/// The parsed file; throws std::runtime_error("<what> <path>: <why>"): not a readable regular file of at most
+/// sbot/core/input_file.h's size limit ("cannot open <what> file (...)", "is a folder, ..."), or not YAML.
 inline YAML::Node loadYamlFile(const std::string& what, const std::string& path) {
-  struct stat st;
-  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) throw std::runtime_error(what + " " + path + ": is a directory");
+  const std::string problem = inputFileProblem(path, what + " file");  // a folder, /dev/zero, a FIFO, too large
+  if (!problem.empty()) throw std::runtime_error(what + " " + path + ": " + problem);
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw std::runtime_error(what + " " + path + ": cannot be read");
+    root = YAML::Load(readInputFile(path, what + " file"));
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(what + " " + path + ": not YAML (" + e.msg + ", line " + std::to_string(e.mark.line + 1) + ")");
   }

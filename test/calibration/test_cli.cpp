@@ -46,21 +46,21 @@ bool contains(const std::string& text, const std::string& part) { return text.fi
 
 TEST(Cli, AnOptionTheSubcommandDoesNotTakeIsRefusedByName) {
   const Outcome o = run("compare " + kExample + " --effect fitted.yaml --no-plots --out " + testing::TempDir() + "cli_typo");
-  EXPECT_EQ(o.status, 1) << o.output;
+  EXPECT_EQ(o.status, 2) << o.output;
   EXPECT_NE(o.output.find("unknown option --effect for 'compare'"), std::string::npos) << o.output;
   EXPECT_NE(o.output.find("--effects"), std::string::npos) << "lists what it takes: " << o.output;
   const Outcome d = run("diagnose " + kExample + " --treshold 5");
-  EXPECT_EQ(d.status, 1) << d.output;
+  EXPECT_EQ(d.status, 2) << d.output;
   EXPECT_NE(d.output.find("unknown option --treshold for 'diagnose'"), std::string::npos) << d.output;
   // Last on the line, a misspelt option is named as such (not as one that "needs a value").
   const Outcome last = run("compare " + kExample + " --no-plot");
-  EXPECT_EQ(last.status, 1) << last.output;
+  EXPECT_EQ(last.status, 2) << last.output;
   EXPECT_NE(last.output.find("unknown option --no-plot for 'compare'"), std::string::npos) << last.output;
 }
 
 TEST(Cli, ABadSolverIsRefusedByName) {
   const Outcome o = run("compare " + kExample + " --solver fast --no-plots --out " + testing::TempDir() + "cli_solver");
-  EXPECT_EQ(o.status, 1) << o.output;
+  EXPECT_EQ(o.status, 2) << o.output;
   EXPECT_NE(o.output.find("--solver expects quickstep or exact, got 'fast'"), std::string::npos) << o.output;
 }
 
@@ -71,7 +71,7 @@ TEST(Cli, AnOutputPlaceThatCannotBeWrittenIsRefusedBeforeTheWork) {
   const std::string dir = testing::TempDir() + "cli_out/";
   std::system(("rm -rf " + dir + " && mkdir -p " + dir + " && touch " + dir + "plain").c_str());
   auto refused = [](const Outcome& o, const std::string& message) {
-    EXPECT_EQ(o.status, 1) << o.output;
+    EXPECT_EQ(o.status, 2) << o.output;
     EXPECT_NE(o.output.find("sbot_calibrate: " + message), std::string::npos) << o.output;
     EXPECT_EQ(o.output.find("nRMS"), std::string::npos) << "nothing was computed: " << o.output;
   };
@@ -117,7 +117,7 @@ TEST(Cli, APerSurfaceEffectIsFittedOnTheDatasetsSurfacesOrRefused) {
             "format: sbot-dataset/1\nname: no_walls\nrobot: medium\nworld: {terrain: {type: plane}}\n"
             "runs:\n  - {name: ir2_head_on, file: ir2_head_on.csv, kind: place}\n");
   const Outcome none = run("fit " + dir + " --effect ir_reflectance --quiet --out " + dir + "none.yaml");
-  EXPECT_EQ(none.status, 1) << none.output;
+  EXPECT_EQ(none.status, 2) << none.output;
   EXPECT_TRUE(contains(none.output, "--effect: ir_reflectance has one parameter per surface")) << none.output;
   EXPECT_TRUE(contains(none.output, "an --effects BASE file")) << "says how to give them: " << none.output;
   EXPECT_FALSE(exists(dir + "none.yaml"));
@@ -141,7 +141,7 @@ TEST(Cli, AFitStoppedByItsIterationLimitGivesNoInterval) {
   EXPECT_TRUE(contains(done.output, "(95 %)")) << done.output;
   EXPECT_TRUE(contains(readFile(dir + "done.yaml"), "stderr: {white_paper: ")) << readFile(dir + "done.yaml");
   const Outcome bad = run("fit " + kIrPoints + " --effect ir_reflectance --max-iterations 0 --out " + dir + "bad.yaml");
-  EXPECT_EQ(bad.status, 1) << bad.output;
+  EXPECT_EQ(bad.status, 2) << bad.output;
   EXPECT_TRUE(contains(bad.output, "--max-iterations")) << bad.output;
 }
 
@@ -168,11 +168,11 @@ TEST(Cli, WhatAFitReportsIsWhatCompareOfItsFileReports) {
 TEST(Cli, AnEffectOnChannelsTheDatasetDoesNotMeasureIsRefusedOrNoted) {
   const std::string dir = freshDir("cli_channels");
   const Outcome fit = run("fit " + kExample + " --effect ir_incidence --quiet --out " + dir + "f.yaml");
-  EXPECT_EQ(fit.status, 1) << fit.output;
+  EXPECT_EQ(fit.status, 2) << fit.output;
   EXPECT_TRUE(contains(fit.output, "--effect: ir_incidence acts on ir, which dataset 'example' does not measure (it measures "))
       << fit.output;
   const Outcome named = run("diagnose " + kIrPoints + " --quiet --candidates ir_ambient,latency");
-  EXPECT_EQ(named.status, 1) << named.output;
+  EXPECT_EQ(named.status, 2) << named.output;
   EXPECT_TRUE(contains(named.output, "--candidates: latency acts on pose, speed, none of which dataset 'seed_ir_response' measures"))
       << named.output;
   const Outcome automatic = run("diagnose " + kIrPoints + " --quiet");
@@ -186,7 +186,7 @@ TEST(Cli, OptionValuesOutsideTheirRangeAndStrayArgumentsAreRefusedByName) {
   const std::string dir = freshDir("cli_values");
   auto refused = [](const std::string& args, const std::string& message) {
     const Outcome o = run(args);
-    EXPECT_EQ(o.status, 1) << args << ": " << o.output;
+    EXPECT_EQ(o.status, 2) << args << ": " << o.output;
     EXPECT_TRUE(contains(o.output, "sbot_calibrate: " + message)) << args << ": " << o.output;
   };
   for (const char* folds : {"0", "1", "-2", "2.5"})
@@ -223,7 +223,7 @@ TEST(Cli, OptionValuesOutsideTheirRangeAndStrayArgumentsAreRefusedByName) {
 TEST(Cli, SweepOptionsAreCheckedByName) {
   auto refused = [](const std::string& args, const std::string& message) {
     const Outcome o = run("sweep --quiet " + args);
-    EXPECT_EQ(o.status, 1) << args << ": " << o.output;
+    EXPECT_EQ(o.status, 2) << args << ": " << o.output;
     EXPECT_TRUE(contains(o.output, "sbot_calibrate: " + message)) << args << ": " << o.output;
   };
   refused("--seeds abc", "--seeds expects a whole number from 1 to 10000 (synthetic datasets per case), got 'abc'");
@@ -263,7 +263,7 @@ TEST(Cli, GenerateRefusesAFolderInUseAndValuesItCannotMake) {
   std::system(("mkdir -p " + dir + "lab && echo 't,x' > " + dir + "lab/measured.csv").c_str());
   const std::string quick = " --families straight --duration 2 --jobs 2 --quiet";
   const Outcome used = run("generate --out " + dir + "lab" + quick);
-  EXPECT_EQ(used.status, 1) << used.output;
+  EXPECT_EQ(used.status, 2) << used.output;
   EXPECT_TRUE(contains(used.output, "sbot_calibrate: --out " + dir + "lab is a folder that is not empty")) << used.output;
   EXPECT_TRUE(contains(used.output, "remove it or choose another folder")) << used.output;
   EXPECT_FALSE(exists(dir + "lab/dataset.yaml"));
@@ -271,7 +271,7 @@ TEST(Cli, GenerateRefusesAFolderInUseAndValuesItCannotMake) {
   const std::string out = " --out " + dir + "new/data";
   auto refused = [&](const std::string& args, const std::string& message) {
     const Outcome o = run("generate" + out + " --jobs 2 --quiet " + args);
-    EXPECT_EQ(o.status, 1) << args << ": " << o.output;
+    EXPECT_EQ(o.status, 2) << args << ": " << o.output;
     EXPECT_TRUE(contains(o.output, "sbot_calibrate: " + message)) << args << ": " << o.output;
     EXPECT_FALSE(exists(dir + "new")) << args << ": a refused run created its output folder";
   };
@@ -295,20 +295,20 @@ TEST(Cli, GenerateRefusesAFolderInUseAndValuesItCannotMake) {
 TEST(Cli, FitAndDiagnoseOutputsAreTriedBeforeTheWorkAndARefusedRunCreatesNoFolder) {
   const std::string dir = freshDir("cli_out_first");
   const Outcome fit = run("fit " + kIrPoints + " --effect ir_reflectance --quiet --out /proc/sbot_fitted.yaml");
-  EXPECT_EQ(fit.status, 1) << fit.output;
+  EXPECT_EQ(fit.status, 2) << fit.output;
   EXPECT_TRUE(contains(fit.output, "sbot_calibrate: --out: cannot write '/proc/sbot_fitted.yaml': ")) << fit.output;
   EXPECT_FALSE(contains(fit.output, "normalised RMS")) << "nothing was fitted: " << fit.output;
   const Outcome diag = run("diagnose " + kIrPoints + " --quiet --write-effects /proc/sbot_diagnosed.yaml");
-  EXPECT_EQ(diag.status, 1) << diag.output;
+  EXPECT_EQ(diag.status, 2) << diag.output;
   EXPECT_TRUE(contains(diag.output, "sbot_calibrate: --write-effects: cannot write '/proc/sbot_diagnosed.yaml': ")) << diag.output;
   EXPECT_FALSE(contains(diag.output, "VERDICT")) << "nothing was diagnosed: " << diag.output;
 
   const Outcome bad_base = run("fit " + kIrPoints + " --effect ir_reflectance --effects " + dir + "no_such.yaml --out " + dir +
                                "made/by/check/f.yaml");
-  EXPECT_EQ(bad_base.status, 1) << bad_base.output;
+  EXPECT_EQ(bad_base.status, 2) << bad_base.output;
   EXPECT_FALSE(exists(dir + "made")) << "the refused run created the folders of its --out";
   const Outcome bad_diag = run("diagnose " + kIrPoints + " --folds 0 --write-effects " + dir + "made/e.yaml");
-  EXPECT_EQ(bad_diag.status, 1) << bad_diag.output;
+  EXPECT_EQ(bad_diag.status, 2) << bad_diag.output;
   EXPECT_FALSE(exists(dir + "made")) << "the refused run created the folder of its --write-effects";
 }
 
@@ -319,15 +319,15 @@ TEST(Cli, TheDatasetsOwnFilesAreNotOverwrittenAndFlagsTakeNoValue) {
   std::system(("cp -r " + kIrPoints + " " + dir + "ds").c_str());
   const std::string yaml = readFile(dir + "ds/dataset.yaml");
   const Outcome fit = run("fit " + dir + "ds --effect ir_reflectance --quiet --out " + dir + "ds/dataset.yaml");
-  EXPECT_EQ(fit.status, 1) << fit.output;
+  EXPECT_EQ(fit.status, 2) << fit.output;
   EXPECT_TRUE(contains(fit.output, "--out: '" + dir + "ds/dataset.yaml' is the dataset's own")) << fit.output;
   EXPECT_EQ(readFile(dir + "ds/dataset.yaml"), yaml) << "the dataset is kept";
   const Outcome diag = run("diagnose " + dir + "ds/ --quiet --write-effects " + dir + "ds/../ds/dataset.yaml");
-  EXPECT_EQ(diag.status, 1) << diag.output;
+  EXPECT_EQ(diag.status, 2) << diag.output;
   EXPECT_TRUE(contains(diag.output, "--write-effects: ")) << diag.output;
   EXPECT_EQ(readFile(dir + "ds/dataset.yaml"), yaml) << "the dataset is kept";
   const Outcome flag = run("compare " + dir + "ds --no-align=false --out " + dir + "report");
-  EXPECT_EQ(flag.status, 1) << flag.output;
+  EXPECT_EQ(flag.status, 2) << flag.output;
   EXPECT_TRUE(contains(flag.output, "--no-align is a flag and takes no value, found '--no-align=false'")) << flag.output;
 }
 
@@ -339,12 +339,12 @@ TEST(Cli, AnEffectsFileWithAnUnknownSurfaceOrStderrKeyIsRefused) {
   writeFile(dir + "stderr.yaml",
             "format: sbot-effects/1\neffects:\n  - name: latency\n    params: {delay: 0.1}\n    stderr: {dely: 0.01}\n");
   const Outcome surface = run("compare " + kIrPoints + " --quiet --no-plots --effects " + dir + "surface.yaml --out " + dir + "r1");
-  EXPECT_EQ(surface.status, 1) << surface.output;
+  EXPECT_EQ(surface.status, 2) << surface.output;
   EXPECT_TRUE(contains(surface.output, dir + "surface.yaml: field 'effects[0].params.green_cheese': ir_reflectance: unknown surface "
                                            "'green_cheese' (known: aluminium, black_card,"))
       << surface.output;
   const Outcome err = run("compare " + kIrPoints + " --quiet --no-plots --effects " + dir + "stderr.yaml --out " + dir + "r2");
-  EXPECT_EQ(err.status, 1) << err.output;
+  EXPECT_EQ(err.status, 2) << err.output;
   EXPECT_TRUE(contains(err.output, dir + "stderr.yaml: field 'effects[0].stderr.dely': a standard error for 'dely', which params does not give (params: delay)"))
       << err.output;
 }
@@ -390,15 +390,15 @@ TEST(Cli, RunsTheModelCannotReplayAreNamedAndLeftOut) {
             {" of 5 runs: ", "arc_left", "left out as not reproducible, and what only they show is not in this verdict"});
   const std::string kept = expectRun("diagnose " + dir + "fast --candidates speed_scale,latency --quiet --keep-chaotic", 0, {"VERDICT"});
   EXPECT_FALSE(contains(kept, "not in this verdict")) << kept;
-  expectRun("compare " + dir + "fast --no-plots --quiet --skip-runs arc_left,spiral --out " + dir + "c", 1,
+  expectRun("compare " + dir + "fast --no-plots --quiet --skip-runs arc_left,spiral --out " + dir + "c", 2,
             {"has no run named spiral (its runs: "});
-  expectRun(fit + "all.yaml --skip-runs arc_left,arc_right,straight_20,straight_40,straight_60", 1, {"leaves dataset"});
+  expectRun(fit + "all.yaml --skip-runs arc_left,arc_right,straight_20,straight_40,straight_60", 2, {"leaves dataset"});
   EXPECT_FALSE(exists(dir + "all.yaml"));
   // sweep diagnoses each synthetic dataset without those runs, and says how many; --keep-chaotic keeps them.
   expectRun("sweep --quiet --level fast --cases none --seeds 1", 0, {"reproducibly left out", ") without "});
   const std::string all = expectRun("sweep --quiet --level fast --cases none --seeds 1 --keep-chaotic", 0, {"(--keep-chaotic)"});
   EXPECT_FALSE(contains(all, ") without ")) << all;
-  expectRun("compare " + dir + "fast --no-plots --keep-chaotic --out " + dir + "c", 1,
+  expectRun("compare " + dir + "fast --no-plots --keep-chaotic --out " + dir + "c", 2,
             {"unknown option --keep-chaotic for 'compare'"});
 }
 

@@ -8,9 +8,11 @@ the robots moved. The same for swarm.launch (5 Simple s-bots, one random_walk no
 by the launch's own rosbag at 10 Hz). Without lock-step the controllers answer a varying number of steps late and the
 two runs differ (see docs/ros_api.md, "Lock-step"). A third run freezes one controller (SIGSTOP, as a
 hung controller or a debugger would) in the middle: the simulator drops it after ~lockstep_timeout
-and finishes the run. (A controller that dies outright unsubscribes, so nothing is held for it.)
+and finishes the run. A fourth kills one controller (SIGKILL): its connections close with its process,
+and the simulator drops it within 1 s of wall time instead of after ~lockstep_timeout.
 """
 import os
+import re
 import signal
 import socket
 import subprocess
@@ -121,6 +123,17 @@ def wait_until(condition, timeout, what):
 
 
 class LockstepRepeatable(unittest.TestCase):
+    def running_controller(self, launch, namespace):
+        """The pid of the launch's controller in `namespace`, once it has started, joined and run."""
+        deadline = time.monotonic() + 30
+        pid = None
+        while pid is None and time.monotonic() < deadline:
+            pid = controller_pid(namespace, launch.pid)
+            time.sleep(0.1)
+        self.assertIsNotNone(pid, "no sbot_phototaxis process in " + namespace)
+        time.sleep(4.0)  # started, joined, running
+        return pid
+
     def test_two_lockstep_runs_agree(self):
         with tempfile.TemporaryDirectory() as d:
             a, summary_a = run_once(d, "a")
@@ -145,13 +158,7 @@ class LockstepRepeatable(unittest.TestCase):
         launch = launch_phototaxis(env, "lockstep:=true", "lockstep_timeout:=1", "duration:=10",
                                    "real_time_factor:=2")
         try:
-            deadline = time.monotonic() + 30
-            pid = None
-            while pid is None and time.monotonic() < deadline:
-                pid = controller_pid("/sbot_2", launch.pid)
-                time.sleep(0.1)
-            self.assertIsNotNone(pid, "no sbot_phototaxis process in /sbot_2")
-            time.sleep(4.0)  # started, joined, running
+            pid = self.running_controller(launch, "/sbot_2")
             os.kill(pid, signal.SIGSTOP)
             time.sleep(3.0)  # > ~lockstep_timeout: dropped by now
             os.kill(pid, signal.SIGKILL)
@@ -160,6 +167,40 @@ class LockstepRepeatable(unittest.TestCase):
             if launch.poll() is None:
                 launch.kill()
         self.assertIn("dropping the controller of sbot_2", out, out[-3000:])
+        summary = [l for l in out.splitlines() if "duration reached" in l]
+        self.assertEqual(len(summary), 1, out[-3000:])
+        self.assertRegex(summary[0], r"lockstep: 3 controllers, held \d+ times .* 1 dropped")
+
+    def test_a_killed_controller_is_dropped_at_once(self):
+        """kill -9: the controller's connections close with its process; the simulator drops it then,
+        within 1 s of wall time, not after ~lockstep_timeout (30 s here, longer than the run)."""
+        env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % free_port())
+        launch = launch_phototaxis(env, "lockstep:=true", "lockstep_timeout:=30", "duration:=10",
+                                   "real_time_factor:=2")
+        # A second subscriber of sbot_2's topics (as a recording would be) keeps the simulator
+        # publishing what the dead controller waited for, so the gate would hold for it.
+        workdir = tempfile.mkdtemp()
+        recorder = subprocess.Popen(["rosbag", "record", "-q", "-e", "/sbot_2/.*", "-O", os.path.join(workdir, "r.bag")],
+                                    env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+        try:
+            pid = self.running_controller(launch, "/sbot_2")
+            killed_at = time.time()
+            os.kill(pid, signal.SIGKILL)
+            out, _ = launch.communicate(timeout=60)
+        finally:
+            if launch.poll() is None:
+                launch.kill()
+            os.killpg(recorder.pid, signal.SIGINT)
+            recorder.wait(timeout=30)
+        drops = [l for l in out.splitlines() if "dropping the controller of sbot_2" in l]
+        self.assertEqual(len(drops), 1, out[-3000:])
+        self.assertIn("connection to sbot_2/", drops[0])
+        # roscpp's log line starts with its wall time: "[ WARN] [1765000000.123456789, 5.230000000]: ..."
+        stamp = re.search(r"\[\s*WARN\]\s*\[(\d+\.\d+)", drops[0])
+        self.assertIsNotNone(stamp, drops[0])
+        dropped_at = float(stamp.group(1))
+        print("lockstep: a kill -9'ed controller dropped %.3f s (wall) after the kill" % (dropped_at - killed_at))
+        self.assertLess(dropped_at - killed_at, 1.0, drops[0])
         summary = [l for l in out.splitlines() if "duration reached" in l]
         self.assertEqual(len(summary), 1, out[-3000:])
         self.assertRegex(summary[0], r"lockstep: 3 controllers, held \d+ times .* 1 dropped")

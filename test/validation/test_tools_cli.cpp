@@ -105,6 +105,33 @@ TEST(ToolsCli, BenchRunsAScenarioFile) {
   EXPECT_EQ(robots, 3) << fewer.output;  // the two listed and one of the swarm block
 }
 
+// One exit status rule (sbot_sim/tools/cli_args.h): 2 for bad input refused before any row, 1 for a
+// failure during the work, 3 for a worker that crashed, named as a crash with its signal.
+TEST(ToolsCli, BenchExitStatusesFollowOneRule) {
+  const std::string bench = SBOT_BENCH_BIN;
+  // --robots 1 builds only the first robot; the second, at y = 1e20, is refused all the same, before the header.
+  const std::string far = testing::TempDir() + "bench_far_robot.yaml";
+  std::ofstream(far) << "robots:\n  - {name: a, level: simple}\n  - {name: b, level: simple, pose: {x: 0, y: 1e20}}\n";
+  const Outcome o = sbot_test::runProcess(bench + " --scenario " + far + " --robots 1 --seconds 0.1");
+  EXPECT_EQ(o.status, 2) << o.output;
+  EXPECT_NE(o.output.find("field 'robots[1].pose': position (0, 1e+20, 0) m is outside the simulated space"), std::string::npos)
+      << o.output;
+  EXPECT_EQ(o.output.find("peak_MiB"), std::string::npos) << "refused before any row: " << o.output;
+  // Degenerate geometry: refused at load time, not by ODE aborting the run.
+  const std::string thin = testing::TempDir() + "bench_thin_box.yaml";
+  std::ofstream(thin) << "world: {terrain: {type: composite, boxes: [{center: [0.3, 0, 0.05], size: [1e-20, 0.6, 0.1]}]}}\n"
+                         "robots: [{name: a, level: simple}]\n";
+  const Outcome t = sbot_test::runProcess(bench + " --scenario " + thin + " --seconds 0.1");
+  EXPECT_EQ(t.status, 2) << t.output;
+  EXPECT_NE(t.output.find("field 'world.terrain.boxes[0].size': every edge must be in [0.0001"), std::string::npos) << t.output;
+  // A worker killed by a signal: exit status 3 and the signal named, not 1 like a refusal.
+  const Outcome k = sbot_test::runProcess(
+      "sh -c '" + bench + " --robots 1 --seconds 100000 & P=$!; C=; for i in $(seq 200); do C=$(pgrep -P $P); "
+      "[ -n \"$C\" ] && break; sleep 0.05; done; sleep 0.3; kill -9 $C; wait $P'");
+  EXPECT_EQ(k.status, 3) << k.output;
+  EXPECT_NE(k.output.find("sbot_bench: the run with 1 robots crashed: killed by signal 9 (Killed)"), std::string::npos) << k.output;
+}
+
 // A benchmark figure names the machine it was measured on: the first processor's model and BogoMIPS
 // from /proc/cpuinfo, and the online cores (a field the file lacks is left out, not guessed).
 TEST(ToolsCli, TheMachineIsNamedFromCpuinfo) {
@@ -248,10 +275,10 @@ TEST(ToolsCli, UnknownSectionsAndUnreadableHeightMapsAreRefusedBeforeAnyRun) {
   const std::string out = "--out " + testing::TempDir() + "cli_refused ";
   expectRefused("sbot_validate", out + "--only fig44", "--only: unknown section 'fig44' (in config/validation/reference_tables.yaml: facts, 4.1,");
   expectRefused("sbot_validate", out + "--only fig4.4 --heightmap /nonexistent/map.png",
-                "--heightmap (or $SBOT_HEIGHTMAP): /nonexistent/map.png: field 'terrain.heightmap_image': cannot read image");
+                "--heightmap (or $SBOT_HEIGHTMAP): /nonexistent/map.png: field 'terrain.heightmap_image': cannot open image (No such file or directory)");
   // A report whose mismatches could not be explained is not written either.
   expectRefused("sbot_validate", out + "--only 4.2 --reasons /nonexistent/reasons.yaml",
-                "sbot_validate: --reasons: mismatch reasons /nonexistent/reasons.yaml: cannot be read");
+                "sbot_validate: --reasons: mismatch reasons /nonexistent/reasons.yaml: cannot open mismatch reasons file");
 }
 
 // Reference tables other than the seed's (--tables): another lab's cells run, their mismatches are
@@ -309,7 +336,7 @@ TEST(ToolsCli, ProbedTablesAndOptionsAreRunOrRefusedAsTheySay) {
   expectRefused("sbot_validate", out + "--speed 30", "--speed goes with --trial (before it)");
   expectRefused("sbot_validate", out + "--index 5", "--index goes with --trial (before it)");
   expectRefused("sbot_validate", out + "--only \"\"", "--only expects a list of sections and table ids, found ''");
-  expectRefused("sbot_validate", out + "--tables " + dir, "--tables: reference tables " + dir + ": is a directory");
+  expectRefused("sbot_validate", out + "--tables " + dir, "--tables: reference tables " + dir + ": is a folder, not a reference tables file");
   // A table of one's own, named like a seed cell, mismatching: the seed's reason is not shown for it.
   std::ofstream(dir + "mine.yaml") << "groups:\n  - {name: mine, title: Mine}\n"
                                       "report:\n  - table:\n      id: \"4.6\"\n      title: Mine\n      group: mine\n      experiment: uphill\n"

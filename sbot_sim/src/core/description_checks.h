@@ -8,6 +8,7 @@
 #include <string>
 
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/input_limits.h"
 #include "sbot_sim/core/robot_description.h"
 
 namespace sbot {
@@ -21,6 +22,11 @@ constexpr double kMaxInertia = 1000;   ///< [kg m^2] per inertia entry
 
 inline void requirePositive(double v, const std::string& file, const std::string& field) {
   if (!(std::isfinite(v) && v > 0)) throw ConfigError(file, field, "must be a finite number > 0");
+}
+
+/// A shape's edge, radius or length: degenerate geometry is refused here, not by an ODE assertion.
+inline void requireGeomSize(double v, const std::string& file, const std::string& field) {
+  if (const std::string problem = geomSizeProblem(v); !problem.empty()) throw ConfigError(file, field, problem);
 }
 
 inline void requireAtMost(double v, double limit, const std::string& file, const std::string& field, const char* unit) {

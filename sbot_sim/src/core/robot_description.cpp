@@ -16,6 +16,8 @@
 
 #include "sbot_sim/core/yaml_checks.h"
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/input_file.h"
+#include "sbot_sim/core/input_limits.h"
 #include "sbot_sim/core/world_config.h"
 #include "description_checks.h"
 
@@ -30,14 +32,6 @@ Pose toPose(const urdf::Pose& p) {
   double x, y, z, w;
   p.rotation.getQuaternion(x, y, z, w);
   return Pose(Vec3(p.position.x, p.position.y, p.position.z), Quat(w, x, y, z).normalized());
-}
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path, "", "cannot open file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 /// The XML of `<link name="NAME" ...>` up to its end, comments removed ("" if not found).
@@ -122,7 +116,7 @@ LinkDescription convertLink(const urdf::Link& link, const std::string& xml, cons
       case urdf::Geometry::SPHERE:
         shape.type = CollisionShape::Type::Sphere;
         shape.radius = static_cast<const urdf::Sphere&>(*col->geometry).radius;
-        requirePositive(shape.radius, file, field + "/sphere radius");
+        requireGeomSize(shape.radius, file, field + "/sphere radius");
         requireAtMost(shape.radius, kMaxLength, file, field + "/sphere radius", "m");
         break;
       case urdf::Geometry::CYLINDER: {
@@ -130,8 +124,8 @@ LinkDescription convertLink(const urdf::Link& link, const std::string& xml, cons
         shape.type = CollisionShape::Type::Cylinder;
         shape.radius = c.radius;
         shape.length = c.length;
-        requirePositive(shape.radius, file, field + "/cylinder radius");
-        requirePositive(shape.length, file, field + "/cylinder length");
+        requireGeomSize(shape.radius, file, field + "/cylinder radius");
+        requireGeomSize(shape.length, file, field + "/cylinder length");
         requireAtMost(std::max(shape.radius, shape.length), kMaxLength, file, field + "/cylinder", "m");
         break;
       }
@@ -139,7 +133,7 @@ LinkDescription convertLink(const urdf::Link& link, const std::string& xml, cons
         const auto& b = static_cast<const urdf::Box&>(*col->geometry);
         shape.type = CollisionShape::Type::Box;
         shape.size = Vec3(b.dim.x, b.dim.y, b.dim.z);
-        for (int k = 0; k < 3; ++k) requirePositive(shape.size[k], file, field + "/box size");
+        for (int k = 0; k < 3; ++k) requireGeomSize(shape.size[k], file, field + "/box size");
         for (int k = 0; k < 3; ++k) requireAtMost(shape.size[k], kMaxLength, file, field + "/box size", "m");
         break;
       }
@@ -236,7 +230,7 @@ RobotDescription loadRobotDescription(const std::string& urdf_path, const std::s
   RobotDescription d;
   d.urdf_path = urdf_path;
   d.sidecar_path = sidecar_path;
-  d.urdf_xml = readFile(urdf_path);
+  d.urdf_xml = readInputFile(urdf_path);
   urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(d.urdf_xml);
   if (!model) throw ConfigError(urdf_path, "", "not a valid URDF (urdfdom's message is printed above)");
   if (!model->getRoot()) throw ConfigError(urdf_path, "", "URDF has no root link");

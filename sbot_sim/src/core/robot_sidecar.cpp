@@ -14,6 +14,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/input_file.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/world_config.h"
 #include "sbot_sim/core/yaml_checks.h"
@@ -197,9 +198,7 @@ static void checkSideArm(const YAML::Node& arm, const RobotDescription& d, const
 YAML::Node loadSidecar(const std::string& file) {
   YAML::Node root;
   try {
-    root = YAML::LoadFile(file);
-  } catch (const YAML::BadFile&) {
-    throw ConfigError(file, "", "cannot open sidecar file");
+    root = YAML::Load(readInputFile(file, "sidecar file"));
   } catch (const YAML::Exception& e) {
     throw ConfigError(file, "", std::string("not valid YAML: ") + e.what());
   }

@@ -11,6 +11,8 @@
 
 #include "sbot_sim/core/yaml_checks.h"
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/input_file.h"
+#include "sbot_sim/core/input_limits.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/world.h"  // robotNameProblem
 
@@ -30,12 +32,20 @@ class Fields {
   }
   std::string path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
   bool has(const std::string& key) const { return present_ && node_[key] && !node_[key].IsNull(); }
+  /// Whether a value is given for `key`; a key given as YAML null (`~`, `null` or nothing after the
+  /// colon) is refused rather than read as the default: leave the key out for that.
+  bool given(const std::string& key) const {
+    if (!present_ || !node_[key]) return false;
+    if (node_[key].IsNull())
+      throw ConfigError(file_, path(key), "is null (~); give a value, or leave the field out for its default");
+    return true;
+  }
   YAML::Node node(const std::string& key) const {
     return has(key) ? node_[key] : YAML::Node(YAML::NodeType::Undefined);
   }
 
   double number(const std::string& key, double fallback) const {
-    if (!has(key)) return fallback;
+    if (!given(key)) return fallback;
     double v;
     try {
       v = node_[key].as<double>();
@@ -43,11 +53,6 @@ class Fields {
       throw ConfigError(file_, path(key), "expected a number, found '" + scalar(key) + "'");
     }
     if (!std::isfinite(v)) throw ConfigError(file_, path(key), "must be finite");
-    return v;
-  }
-  double positive(const std::string& key, double fallback) const {
-    const double v = number(key, fallback);
-    if (!(v > 0)) throw ConfigError(file_, path(key), "must be > 0");
     return v;
   }
   double within(const std::string& key, double fallback, double lo, double hi) const {
@@ -62,13 +67,29 @@ class Fields {
       throw ConfigError(file_, path(key), "must be a whole number in [" + fmt(lo) + ", " + fmt(hi) + "], found " + fmt(v));
     return static_cast<long long>(v);
   }
+  /// `v` (read from `key`) unless `problem` (an input_limits.h / positionProblem check) refuses it.
+  template <class T>
+  T checked(const std::string& key, T v, const std::string& problem) const {
+    if (!problem.empty()) throw ConfigError(file_, path(key), problem);
+    return v;
+  }
+  /// An angle [rad] within input_limits.h's range.
+  double angle(const std::string& key, double fallback) const {
+    const double v = number(key, fallback);
+    return checked(key, v, angleProblem(v));
+  }
+  /// An edge or length of geometry [m] within input_limits.h's range.
+  double geomSize(const std::string& key, double fallback) const {
+    const double v = number(key, fallback);
+    return checked(key, v, geomSizeProblem(v));
+  }
   std::string text(const std::string& key, const std::string& fallback) const {
-    if (!has(key)) return fallback;
+    if (!given(key)) return fallback;
     if (!node_[key].IsScalar()) throw ConfigError(file_, path(key), "expected a string");
     return node_[key].as<std::string>();
   }
   bool flag(const std::string& key, bool fallback) const {
-    if (!has(key)) return fallback;
+    if (!given(key)) return fallback;
     try {
       return node_[key].as<bool>();
     } catch (const YAML::Exception&) {
@@ -104,7 +125,7 @@ class Fields {
   }
   /// A list of exactly `n` finite numbers into out[0..n); absent: out unchanged.
   void numbers(const std::string& key, int n, const char* shape, double* out) const {
-    if (!has(key)) return;
+    if (!given(key)) return;
     const YAML::Node list = node_[key];
     if (!list.IsSequence() || static_cast<int>(list.size()) != n)
       throw ConfigError(file_, path(key), std::string("expected ") + shape);
@@ -132,7 +153,10 @@ std::string checkLevel(const std::string& level, const std::string& file, const 
 Pose2D parsePose(const YAML::Node& n, const std::string& path, const std::string& file) {
   Fields f(n, path, file);
   f.allowOnly({"x", "y", "yaw"});
-  return Pose2D{f.number("x", 0), f.number("y", 0), f.number("yaw", 0)};
+  const Pose2D pose{f.number("x", 0), f.number("y", 0), f.angle("yaw", 0)};
+  if (const std::string where = positionProblem(Vec3(pose.x, pose.y, 0)); !where.empty())
+    throw ConfigError(file, path, where);
+  return pose;
 }
 
 void parseTerrain(const YAML::Node& n, TerrainConfig& t, const std::string& file) {
@@ -159,8 +183,7 @@ void parseTerrain(const YAML::Node& n, TerrainConfig& t, const std::string& file
     const double s = f.within("size", 5.0, kMinTerrainSize, kMaxTerrainSize);
     t.size_x = t.size_y = s;
   }
-  t.height_range = f.number("height_range", 0.0);
-  if (t.height_range < 0) throw ConfigError(file, f.path("height_range"), "must be >= 0");
+  t.height_range = f.within("height_range", 0.0, 0, kMaxTerrainSize);
   t.heightmap_seed = static_cast<std::uint64_t>(f.integer("seed", 1, 0, kMaxSeed));
 
   if (const YAML::Node boxes = f.node("boxes")) {
@@ -171,10 +194,11 @@ void parseTerrain(const YAML::Node& n, TerrainConfig& t, const std::string& file
       BoxObstacle box;
       box.name = b.text("name", "box_" + std::to_string(i));
       box.center = b.vec3("center", Vec3::Zero());
+      b.checked("center", 0, positionProblem(box.center));
       box.size = b.vec3("size", Vec3::Ones());
-      if ((box.size.array() <= 0).any()) throw ConfigError(file, b.path("size"), "every edge must be > 0");
-      box.yaw = b.number("yaw", 0);
-      box.pitch = b.number("pitch", 0);
+      b.checked("size", 0, boxSizeProblem(box.size));
+      box.yaw = b.angle("yaw", 0);
+      box.pitch = b.angle("pitch", 0);
       box.surface = b.text("surface", "ground");
       for (const BoxObstacle& other : t.boxes)
         if (other.name == box.name)
@@ -185,7 +209,7 @@ void parseTerrain(const YAML::Node& n, TerrainConfig& t, const std::string& file
   if (const YAML::Node arena = f.node("arena")) {
     Fields a(arena, f.path("arena"), file);
     a.allowOnly({"size", "height", "thickness", "surface"});
-    const double s = a.positive("size", 4.0), h = a.positive("height", 0.1), th = a.positive("thickness", 0.02);
+    const double s = a.geomSize("size", 4.0), h = a.geomSize("height", 0.1), th = a.geomSize("thickness", 0.02);
     const std::string surface = a.text("surface", "wall");
     const double o = s / 2 + th / 2;
     const std::size_t own_boxes = t.boxes.size();
@@ -274,7 +298,7 @@ void checkGravityOfLevels(const Scenario& s, const std::string& file) {
 void parseSensedEnvironment(const YAML::Node& world, Scenario& s, const std::string& file) {
   Fields w(world, "world", file);
   s.ambient_light = w.number("ambient_light", 0);
-  if (s.ambient_light < 0) throw ConfigError(file, w.path("ambient_light"), "must be >= 0 [mcd/cm^2]");
+  w.checked("ambient_light", 0, lightIntensityProblem(s.ambient_light, "mcd/cm^2"));
   const YAML::Node lamps = w.node("lamps");
   if (!lamps) return;
   if (!lamps.IsSequence()) throw ConfigError(file, w.path("lamps"), "expected a list of {position, intensity, colour}");
@@ -287,7 +311,7 @@ void parseSensedEnvironment(const YAML::Node& world, Scenario& s, const std::str
     if (const std::string where = positionProblem(lamp.position); !where.empty())
       throw ConfigError(file, l.path("position"), where);
     lamp.intensity = l.number("intensity", 0);
-    if (lamp.intensity < 0) throw ConfigError(file, l.path("intensity"), "must be >= 0 [mcd]");
+    l.checked("intensity", 0, lightIntensityProblem(lamp.intensity, "mcd"));
     lamp.colour = l.vec3("colour", lamp.colour);
     if (lamp.colour.minCoeff() < 0 || lamp.colour.maxCoeff() > 1)
       throw ConfigError(file, l.path("colour"), "expected [r, g, b] in [0, 1]");
@@ -312,13 +336,12 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
   Scenario s;
   s.source = file;
   s.world.seed = static_cast<std::uint64_t>(f.integer("seed", 1, 0, kMaxSeed));
-  s.duration = f.number("duration", 0);
+  s.duration = f.within("duration", 0, 0, kMaxDuration);
   s.effects_file = f.text("effects", "");
   if (!s.effects_file.empty() && s.effects_file[0] != '/') {
     const auto slash = file.find_last_of('/');
     if (slash != std::string::npos) s.effects_file = file.substr(0, slash + 1) + s.effects_file;
   }
-  if (s.duration < 0) throw ConfigError(file, "duration", "must be >= 0");
   parseWorld(f.node("world"), s.world, file);
   parseSensedEnvironment(f.node("world"), s, file);
 
@@ -346,12 +369,13 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
     const std::string layout = sw.text("layout", "grid");
     if (layout != "grid" && layout != "random")
       throw ConfigError(file, "swarm.layout", "expected grid or random, found '" + layout + "'");
-    const double spacing = sw.positive("spacing", 0.3);
+    const double spacing = sw.within("spacing", 0.3, kMinGeomSize, kMaxGeomSize);
     double cx = 0, cy = 0;
     sw.xy("center", &cx, &cy);
+    sw.checked("center", 0, positionProblem(Vec3(cx, cy, 0)));
     const int side = std::max(1, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(count)))));
     std::mt19937_64 rng(s.world.seed * 7919 + 17);
-    const double area = sw.positive("area", side * spacing);
+    const double area = sw.within("area", side * spacing, kMinGeomSize, kMaxGeomSize);
     std::uniform_real_distribution<double> uni(-area / 2, area / 2), ang(-M_PI, M_PI);
     const std::size_t first = s.robots.size();
     for (int i = 0; i < count; ++i) {
@@ -419,11 +443,7 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& file, in
 }
 
 Scenario loadScenario(const std::string& path, int robot_count) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path, "", "cannot open scenario file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseScenario(ss.str(), path, robot_count);
+  return parseScenario(readInputFile(path, "scenario file"), path, robot_count);
 }
 
 std::string scenarioYaml(const Scenario& sc, const std::string& name, const std::string& description) {

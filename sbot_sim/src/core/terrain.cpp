@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/input_file.h"
 #include "sbot_sim/core/random_streams.h"
 
 namespace sbot {
@@ -63,6 +64,8 @@ HeightMap makeHeightMap(const TerrainConfig& t) {
   map.size_y = t.size_y;
   std::vector<double> raw;
   if (!t.heightmap_image.empty()) {
+    if (const std::string problem = inputFileProblem(t.heightmap_image, "image"); !problem.empty())
+      throw ConfigError(t.heightmap_image, "terrain.heightmap_image", problem);
     cv::Mat img = cv::imread(t.heightmap_image, cv::IMREAD_GRAYSCALE);
     if (img.empty()) throw ConfigError(t.heightmap_image, "terrain.heightmap_image", "cannot read image");
     if (img.rows < 2 || img.cols < 2) throw ConfigError(t.heightmap_image, "terrain.heightmap_image", "image smaller than 2x2");

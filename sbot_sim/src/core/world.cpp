@@ -14,7 +14,9 @@
 #include <string>
 
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/input_limits.h"
 #include "sbot_sim/core/random_streams.h"
+#include "ode_errors.h"
 #include "world_internal.h"
 
 namespace sbot {
@@ -22,20 +24,11 @@ namespace {
 
 // ODE's informational messages (with the exact solver: "LCP internal error" whenever contacts are
 // redundant, up to every step) would flood the logs: print the first ten, then every 1000th.
-void odeMessage(int num, const char* msg, va_list ap) {
-  static std::atomic<long> count{0};
-  const long n = ++count;
-  if (n > 10 && n % 1000 != 0) return;
-  std::fprintf(stderr, "ODE message %d (%ld so far): ", num, n);
-  std::vfprintf(stderr, msg, ap);
-  std::fprintf(stderr, "\n");
-}
-
 void initOdeOnce() {
   static std::once_flag once;
   std::call_once(once, [] {
     dInitODE2(0);
-    dSetMessageHandler(&odeMessage);
+    installOdeHandlers();  // ODE errors name the robot, body and step (ode_errors.h)
   });
   // Every thread that touches ODE needs its own collision scratch data (parallel simulations).
   dAllocateODEDataForThread(dAllocateMaskAll);
@@ -87,10 +80,11 @@ World::~World() {
 std::string robotNameProblem(const std::string& name) {
   const auto letter = [](char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'); };
   const auto digit = [](char c) { return c >= '0' && c <= '9'; };
-  bool ok = !name.empty() && letter(name[0]);
+  bool ok = !name.empty() && name.size() <= kMaxRobotNameLength && letter(name[0]);
   for (char c : name) ok = ok && (letter(c) || digit(c) || c == '_');
   if (ok) return "";
-  return "invalid robot name '" + name + "' (a ROS name: a letter, then letters, digits or '_')";
+  return "invalid robot name '" + name.substr(0, kMaxRobotNameLength) + (name.size() > kMaxRobotNameLength ? "...'" : "'") +
+         " (a ROS name of at most " + std::to_string(kMaxRobotNameLength) + " characters: a letter, then letters, digits or '_')";
 }
 
 Robot& World::addRobotAt(const RobotDescription& description, const Pose& pose, const std::string& name) {
@@ -172,6 +166,7 @@ void World::step() {
     mark = now;
   };
   const double dt = config_.step;
+  const OdeStepScope ode_scope(*this);
   // A new gravity (a slope experiment tilts it) disturbs every robot.
   dVector3 ode_g;
   dWorldGetGravity(world_, ode_g);
@@ -196,6 +191,7 @@ void World::step() {
   // count makes every run of a scenario bit-identical whatever other worlds did in this process.
   // (Worlds in parallel threads would share that generator: run parallel simulations as processes.)
   dRandSetSeed(static_cast<unsigned long>(stableHash(config_.seed, std::to_string(steps_))));
+  noteOdePhase("the solver");
   if (exact_solver_)
     dWorldStep(world_, dt);
   else

@@ -8,6 +8,7 @@
 #include <set>
 #include <string>
 
+#include "ode_errors.h"
 #include "world_internal.h"
 
 namespace sbot {
@@ -116,6 +117,7 @@ void World::collideRobots(const Robot& a, const Robot& b) {
 }
 
 void World::handlePair(dGeomID a, dGeomID b) {
+  noteOdePair(a, b);
   if (dGeomIsSpace(a) || dGeomIsSpace(b)) {
     // Two sleeping robots' contacts would join no island (ODE solves only what an enabled body
     // reaches): not made; in a resting cluster they were half the step. If one of them wakes,

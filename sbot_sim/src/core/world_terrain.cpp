@@ -8,6 +8,7 @@
 #include <string>
 
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/input_limits.h"
 #include "sbot_sim/core/terrain.h"
 #include "world_internal.h"
 
@@ -19,7 +20,7 @@ void World::buildTerrain() {
     std::string problem = positionProblem(box.center);
     if (problem.empty()) problem = positionProblem(box.size);
     // A box without volume is degenerate for ODE's collision tests (an assertion, not an error).
-    if (problem.empty() && !(box.size.array() > 0).all()) problem = "every edge of a box must be > 0";
+    if (problem.empty()) problem = boxSizeProblem(box.size);
     if (!problem.empty()) throw ConfigError("<world>", "terrain.boxes (" + box.name + ")", problem);
   }
   if (t.type == TerrainConfig::Type::Rough) {

@@ -147,6 +147,21 @@ bool LockstepGate::mayStep() {
              "%zu so far (%s)", params_.controllers, announced_.size(), joined.empty() ? "none" : joined.c_str());
   }
   for (auto it = waiting_.begin(); it != waiting_.end();) {
+    // A controller that was connected to the topic it waits on and no longer is has ended: its
+    // process closed the connection (kill -9 included), and it will never sync again.
+    const Waiter& w = it->second;
+    std::set<std::string>& connected = robots_[it->first].connected;
+    const std::string link = w.node + " " + w.sync.channel;
+    if (publicationStamps().listened(w.sync.robot, w.sync.channel, w.node)) {
+      connected.insert(link);
+    } else if (connected.erase(link)) {
+      ROS_WARN("simulator: lockstep: dropping the controller of %s (%s): its connection to %s/%s closed (its "
+               "process ended); the simulation no longer waits for it", it->first.c_str(), w.node.c_str(),
+               it->first.c_str(), w.sync.channel.c_str());
+      ++dropped_;
+      it = waiting_.erase(it);
+      continue;
+    }
     ros::Time published;
     const Hold why = holdFor(it->second, &published);
     if (why == Hold::None) {

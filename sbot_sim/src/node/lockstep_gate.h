@@ -19,8 +19,12 @@
 //   * when it starts holding for a new message, tells the controller on R/lockstep_hold
 //     (sbot_msgs/LockstepHold) what it has published on each topic the controller reads up to then:
 //     the controller's getters wait for exactly that, whatever order the topics' messages arrive in;
+//   * drops a controller whose process has ended (killed, crashed) as soon as its connection to the
+//     topic it waits on closes: the node's publisher of R/<channel> loses it from its subscribers
+//     (publicationStamps().listened; a kill -9'ed controller is dropped within a fraction of a
+//     second, test/lockstep/test_lockstep_repeatable.py), with a warning naming it;
 //   * drops a controller that holds the clock for ~lockstep_timeout wall seconds without a new sync
-//     (crashed, or busy-looping without reading a sensor), with a warning naming it.
+//     (hung, or busy-looping without reading a sensor), with a warning naming it.
 // Between two sensor messages the controllers are blocked and the simulator runs freely, so every
 // command a controller computes from the message stamped t applies at the first step after t.
 #pragma once
@@ -75,6 +79,9 @@ class LockstepGate {
     std::vector<std::string> channels;     ///< topics under the robot its controller reads
     ros::Publisher hold_pub;               ///< <robot>/lockstep_hold (latched)
     ros::Time hold_sent;                   ///< stamp of the last hold told
+    /// "<controller node> <channel>" pairs seen connected: the node's publisher of robot/channel
+    /// has had that controller among its subscribers.
+    std::set<std::string> connected;
   };
   enum class Hold { None, Commands, Subscribing, Message };
 

@@ -6,6 +6,7 @@
 #include <sbot_msgs/SensorsAvailable.h>
 
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/input_limits.h"
 #include "sbot_sim/ros/typed_param.h"
 
 namespace sbot_node {
@@ -286,8 +287,8 @@ bool RobotModulesRos::onSetSamplingRate(sbot_msgs::SetSamplingRate::Request& req
       return true;
     }
   } else {
-    if (!std::isfinite(req.hz) || req.hz <= 0) {
-      res.message = "hz must be finite and > 0, got " + std::to_string(req.hz);
+    if (const std::string problem = sbot::samplingRateProblem(req.hz); !problem.empty()) {
+      res.message = "hz " + problem;
       res.applied_hz = it->second.hz;
       return true;
     }
@@ -398,12 +399,8 @@ bool ModulesRosInterface::onSetLamp(sbot_msgs::SetLamp::Request& req, sbot_msgs:
     res.message = "no world";
     return true;
   }
-  if (!std::isfinite(req.intensity)) {
-    res.message = "intensity is not finite";
-    return true;
-  }
-  if (req.intensity < 0) {
-    res.message = "intensity must be >= 0 mcd, got " + std::to_string(req.intensity);
+  if (const std::string problem = sbot::lightIntensityProblem(req.intensity, "mcd"); !problem.empty()) {
+    res.message = "intensity " + problem;
     return true;
   }
   if (req.lamp >= env_->lamps().size()) {
@@ -420,12 +417,8 @@ bool ModulesRosInterface::onSetLamp(sbot_msgs::SetLamp::Request& req, sbot_msgs:
 bool ModulesRosInterface::onSetAmbient(sbot_msgs::SetAmbientLight::Request& req,
                                        sbot_msgs::SetAmbientLight::Response& res) {
   res.success = false;
-  if (!std::isfinite(req.intensity)) {
-    res.message = "intensity is not finite";
-    return true;
-  }
-  if (req.intensity < 0) {
-    res.message = "intensity must be >= 0 mcd/cm^2, got " + std::to_string(req.intensity);
+  if (const std::string problem = sbot::lightIntensityProblem(req.intensity, "mcd/cm^2"); !problem.empty()) {
+    res.message = "intensity " + problem;
     return true;
   }
   ambient_ = req.intensity;

@@ -2,6 +2,7 @@
 
 #include "publication_stamps.h"
 #include "robot_lookup.h"
+#include "sbot_sim/core/input_limits.h"
 
 #include "sbot_sim/core/scenario_world.h"
 
@@ -465,6 +466,10 @@ bool SimRosInterface::onSetPose(sbot_msgs::SetPose::Request& req, sbot_msgs::Set
       res.message = std::string("field ") + f.first + " is not finite (" + std::to_string(f.second) + ")";
       return true;
     }
+  }
+  if (const std::string problem = sbot::angleProblem(req.yaw); !problem.empty()) {
+    res.message = "field yaw " + problem;
+    return true;
   }
   try {
     res.message = world_->placeRobot(*robot, sbot::Pose(sbot::Vec3(req.x, req.y, req.z), sbot::quatFromRPY(0, 0, req.yaw)));

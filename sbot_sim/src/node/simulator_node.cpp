@@ -12,7 +12,9 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "simulator", ros::init_options::NoSigintHandler);
   std::signal(SIGINT, sbot_node::SimRosInterface::requestStop);
   std::signal(SIGTERM, sbot_node::SimRosInterface::requestStop);
-  int code = 1;
+  // Exit status: 2 when the scenario or a parameter is refused at start-up, 1 when a step fails
+  // (an ODE error ends the process with 1 itself: src/core/ode_errors.h), 0 otherwise.
+  int code = 2;
   {
     sbot_node::SimRosInterface sim;
     if (sim.init()) code = sim.run();

@@ -11,6 +11,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/input_limits.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/swarm/swarm_graph.h"
 
@@ -203,6 +204,10 @@ bool SwarmRosInterface::onSpawn(sbot_msgs::Spawn::Request& req, sbot_msgs::Spawn
       res.message = std::string("field ") + f.first + " is not finite";
       return true;
     }
+  }
+  if (const std::string problem = sbot::angleProblem(req.yaw); !problem.empty()) {
+    res.message = "field yaw " + problem;
+    return true;
   }
   sbot::Robot* robot = nullptr;
   try {

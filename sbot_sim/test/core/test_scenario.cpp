@@ -355,11 +355,11 @@ links: [{holder: holder, held: held, kind: side_arm}]
 TEST(Scenario, LampsAndAmbientLightAreCheckedByField) {
   refused("world: {ambient_light: .inf}", "'world.ambient_light': must be finite");
   refused("world: {ambient_light: .nan}", "'world.ambient_light': must be finite");
-  refused("world: {ambient_light: -100}", "'world.ambient_light': must be >= 0");
+  refused("world: {ambient_light: -100}", "'world.ambient_light': must be in [0, 1e+09] mcd/cm^2, found -100");
   refused("world: {ambient_light: bright}", "'world.ambient_light': expected a number, found 'bright'");
   const std::string ok = "{position: [0, 0, 1], intensity: 10}";
   refused("world: {lamps: [" + ok + ", {position: [0, 0, 1], intensity: .nan}]}", "'world.lamps[1].intensity': must be finite");
-  refused("world: {lamps: [{position: [0, 0, 1], intensity: -1}]}", "'world.lamps[0].intensity': must be >= 0");
+  refused("world: {lamps: [{position: [0, 0, 1], intensity: -1}]}", "'world.lamps[0].intensity': must be in [0, 1e+09] mcd, found -1");
   refused("world: {lamps: [{position: [0.8], intensity: 1}]}", "'world.lamps[0].position': expected [x, y, z]");
   refused("world: {lamps: [{intensity: 1}]}", "'world.lamps[0].position': missing");
   refused("world: {lamps: [{position: [1e9, 0, 1]}]}", "'world.lamps[0].position'");
@@ -397,6 +397,43 @@ TEST(Scenario, MissingFileIsReported) {
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/scenario.yaml: cannot open"), std::string::npos);
   }
+}
+
+// Stated ranges (sbot_sim/core/input_limits.h) and YAML null.
+const char* kRobot = "robots: [{name: a, level: simple}]\n";
+
+TEST(ScenarioRanges, EveryFieldHasAStatedRange) {
+  refused(std::string("world: {terrain: {type: composite, boxes: [{size: [1e-20, 0.6, 0.1]}]}}\n") + kRobot,
+          "field 'world.terrain.boxes[0].size': every edge must be in [0.0001, 200000] m, found 1e-20");
+  refused("world: {terrain: {arena: {thickness: 1e-20}}}\n", "field 'world.terrain.arena.thickness': must be in [0.0001");
+  refused("robots: [{name: a, pose: {yaw: -1e308}}]\n", "field 'robots[0].pose.yaw': must be in [-6.28319, 6.28319] rad");
+  refused("robots: [{name: a, pose: {x: 0, y: 1e20}}]\n", "field 'robots[0].pose': position (0, 1e+20, 0) m is outside");
+  refused("world: {terrain: {type: composite, boxes: [{yaw: 1e308}]}}\n", "field 'world.terrain.boxes[0].yaw': must be in");
+  refused("world: {terrain: {type: composite, boxes: [{center: [1e9, 0, 0]}]}}\n",
+          "field 'world.terrain.boxes[0].center': position (1e+09, 0, 0) m is outside");
+  refused("world: {lamps: [{position: [0, 0, 1], intensity: 1e308}]}\n",
+          "field 'world.lamps[0].intensity': must be in [0, 1e+09] mcd, found 1e+308");
+  refused("world: {ambient_light: 1e308}\n", "field 'world.ambient_light': must be in [0, 1e+09] mcd/cm^2");
+  refused("duration: 1e308\n", "field 'duration': must be in [0, 1e+09]");
+  refused("swarm: {count: 2, spacing: 1e-30}\n", "field 'swarm.spacing': must be in [0.0001, 200000]");
+  refused("swarm: {count: 2, center: [1e30, 0]}\n", "field 'swarm.center': position (1e+30, 0, 0) m is outside");
+  refused("world: {terrain: {type: rough, height_range: 1e300}}\n", "field 'world.terrain.height_range': must be in [0, 10000]");
+  refused("robots: [{name: " + std::string(10000, 'a') + "}]\n",
+          "(a ROS name of at most 64 characters: a letter, then letters, digits or '_')");
+  // The limits themselves are accepted.
+  EXPECT_EQ(errorOf(std::string("world: {terrain: {type: composite, boxes: [{size: [1e-4, 0.6, 0.1], yaw: 6.28}]}}\n") + kRobot), "");
+  EXPECT_EQ(errorOf("robots: [{name: " + std::string(64, 'a') + "}]\n"), "");
+}
+
+TEST(ScenarioRanges, YamlNullIsRefusedNotReadAsTheDefault) {
+  refused("seed: ~\n", "field 'seed': is null (~); give a value, or leave the field out for its default");
+  refused("robots: [{name: a, pose: {x: 0, yaw: ~}}]\n", "field 'robots[0].pose.yaw': is null");
+  refused("robots: [{name: a, pose: {x: 0, yaw: }}]\n", "field 'robots[0].pose.yaw': is null");
+  refused("world: {step: null}\n", "field 'world.step': is null");
+  refused("robots: [{name: ~}]\n", "field 'robots[0].name': is null");
+  refused("world: {contact: {materials: {ground: ~}}}\n", "field 'world.contact.materials.ground': is null");
+  // An empty section still reads as all defaults.
+  EXPECT_EQ(errorOf("world:\nrobots: [{name: a}]\n"), "");
 }
 
 }  // namespace

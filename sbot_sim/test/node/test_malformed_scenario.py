@@ -46,6 +46,8 @@ class TestMalformedScenario(unittest.TestCase):
         self.assertNotEqual(proc.returncode, 0, 'the simulator accepted it; stderr:\n' + proc.stderr)
         self.assertGreater(proc.returncode, 0, 'the simulator crashed (signal %d); stderr:\n%s'
                            % (-proc.returncode, proc.stderr))
+        # Bad input refused before any step: exit status 2 (sbot_sim/tools/cli_args.h).
+        self.assertEqual(proc.returncode, 2, proc.stderr)
         self.assertIn('FATAL', proc.stderr)
         for needle in needles:
             self.assertIn(needle, proc.stderr, 'stderr does not name %r:\n%s' % (needle, proc.stderr))
@@ -113,6 +115,28 @@ class TestMalformedScenario(unittest.TestCase):
     def test_infinite_ambient_light(self):
         path = self.scenario_with('  ambient_light: .inf\n')
         self.assertRefused(self.run_node('_scenario:=' + path), path, 'world.ambient_light', 'must be finite')
+
+    def test_out_of_range_and_null_values(self):
+        for world, field, words in (
+                ('  ambient_light: 1e308\n', 'world.ambient_light', 'must be in [0, 1e+09] mcd/cm^2'),
+                ('  lamps: [{position: [0, 0, 1], intensity: 1e308}]\n', 'world.lamps[0].intensity', 'must be in [0, 1e+09] mcd'),
+                ('  gravity: ~\n', 'world.gravity', 'is null (~)')):
+            path = self.scenario_with(world)
+            self.assertRefused(self.run_node('_scenario:=' + path), path, field, words)
+        path = self.scenario_with('')
+        with open(path) as f:
+            text = f.read().replace('terrain: {type: plane}', 'terrain: {type: composite, boxes: '
+                                    '[{center: [3, 3, 0.05], size: [1e-20, 0.6, 0.1]}]}')
+        with open(path, 'w') as f:
+            f.write(text)
+        self.assertRefused(self.run_node('_scenario:=' + path), path, 'world.terrain.boxes[0].size',
+                           'every edge must be in [0.0001, 200000] m')
+
+    def test_special_files_are_refused(self):
+        fifo = os.path.join(tempfile.mkdtemp(), 'scenario.fifo')
+        os.mkfifo(fifo)
+        for path in ('/dev/zero', fifo):
+            self.assertRefused(self.run_node('_scenario:=' + path), path, 'is not a regular file')
 
     def test_lamp_without_a_position(self):
         path = self.scenario_with('  lamps: [{position: [0, 0, 1], intensity: 10}, {intensity: 5}]\n')

@@ -82,6 +82,10 @@ class Modules(unittest.TestCase):
         self.assertFalse(srv(channel='proximity', rate=42, hz=0).success)
         self.assertFalse(srv(channel='nonsense', rate=4, hz=0).success)
         self.assertFalse(srv(channel='slope', rate=0, hz=float('nan')).success)
+        for hz in (5e-324, 0.001):  # below the slowest stated rate, 0.01 Hz (one message per 100 s)
+            res = srv(channel='slope', rate=0, hz=hz)
+            self.assertFalse(res.success, hz)
+            self.assertIn('hz must be finite and >= 0.01 Hz', res.message)
         # Above the step rate (100 Hz here) the reply said the rate asked (1e300), not the one given.
         res = srv(channel='slope', rate=0, hz=1e300)
         self.assertTrue(res.success, res.message)
@@ -158,10 +162,16 @@ class Modules(unittest.TestCase):
         self.assertFalse(lamp(lamp=0, intensity=float('nan')).success)
         self.assertFalse(lamp(lamp=0, intensity=-1).success)
         self.assertFalse(lamp(lamp=3, intensity=1).success)
+        res = lamp(lamp=0, intensity=1e308)
+        self.assertFalse(res.success)
+        self.assertIn('intensity must be in [0, 1e+09] mcd', res.message)
         self.assertTrue(lamp(lamp=0, intensity=300000).success)
         amb = rospy.ServiceProxy('/sim/set_ambient_light', SetAmbientLight)
         self.assertFalse(amb(intensity=float('inf')).success)
         self.assertFalse(amb(intensity=-2).success)
+        res = amb(intensity=1e308)
+        self.assertFalse(res.success)
+        self.assertIn('intensity must be in [0, 1e+09] mcd/cm^2', res.message)
         self.assertTrue(amb(intensity=2.0).success)
 
     def test_sensor_markers(self):

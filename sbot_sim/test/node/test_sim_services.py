@@ -54,6 +54,11 @@ class TestSimServices(unittest.TestCase):
         res = self.sim.set_pose('sbot_1', 0.0, 0.0, 0.05, float('inf'))
         self.assertFalse(res.success)
         self.assertIn('yaw', res.message)
+        # Finite but outside the stated range (sbot_sim/core/input_limits.h): one turn either way.
+        for yaw in (1e308, -1e308, 6.3):
+            res = self.sim.set_pose('sbot_1', 0.0, 0.0, 0.05, yaw)
+            self.assertFalse(res.success, yaw)
+            self.assertIn('field yaw must be in [-6.28319, 6.28319] rad', res.message)
         self.assertAlive()
 
     def test_set_pose_teleports(self):

@@ -109,6 +109,13 @@ class TestSwarm(unittest.TestCase):
             res = self.spawn(name, 'simple', 1.0, 1.0, 0.0)
             self.assertFalse(res.success, name)
             self.assertIn("invalid robot name '%s'" % name, res.message)
+        res = self.spawn('a' * 10000, 'simple', 1.0, 1.0, 0.0)
+        self.assertFalse(res.success)
+        self.assertIn('a ROS name of at most 64 characters', res.message)
+        self.assertLess(len(res.message), 300)  # names the start of it, not all 10000 characters
+        res = self.spawn('sbot_9', 'simple', 1.0, 1.0, 1e308)
+        self.assertFalse(res.success)
+        self.assertIn('field yaw must be in [-6.28319, 6.28319] rad', res.message)
         res = self.spawn('sbot_9', 'simple', -0.8, -0.78, 0.0)  # onto sbot_2
         self.assertFalse(res.success)
         self.assertIn("'sbot_9' there would overlap robot 'sbot_2'", res.message)

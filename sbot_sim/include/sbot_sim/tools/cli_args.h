@@ -4,9 +4,12 @@
 // atoi/atof's silent 0 or an empty string.
 #pragma once
 
+#include <sys/wait.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <string>
 
@@ -14,6 +17,31 @@
 #include "sbot_sim/core/robot_description.h"
 
 namespace sbot_tools {
+
+/// Exit statuses, one rule for every tool (sbot_bench, sbot_validate, sbot_calibrate,
+/// switching_experiment, two_sbots; simulator_node ends with 1 on a failure):
+///   0  done;
+///   2  bad input (an option, a file, a field) refused before any work: no result written, no row printed;
+///   1  a failure during the work (a run that threw, an ODE error: sbot_sim/src/core/ode_errors.h);
+///   3  a worker process crashed (killed by a signal), reported as a crash with the signal's name.
+/// A tool with several failures exits with the most severe: 3 over 1.
+constexpr int kExitDone = 0, kExitFailure = 1, kExitBadInput = 2, kExitCrash = 3;
+
+/// The exit status a worker's waitpid `status` contributes (kExitDone, kExitFailure or kExitCrash);
+/// a crash is reported as "TOOL: WHAT crashed: killed by signal N (NAME)".
+inline int workerOutcome(const char* tool, const std::string& what, int status) {
+  if (WIFSIGNALED(status)) {
+    std::fprintf(stderr, "%s: %s crashed: killed by signal %d (%s)\n", tool, what.c_str(), WTERMSIG(status),
+                 strsignal(WTERMSIG(status)));
+    return kExitCrash;
+  }
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? kExitDone : kExitFailure;
+}
+/// The more severe of two exit statuses (kExitCrash over kExitFailure over kExitDone).
+inline int worseExit(int a, int b) {
+  auto rank = [](int s) { return s == kExitCrash ? 3 : s == kExitBadInput ? 2 : s == kExitFailure ? 1 : 0; };
+  return rank(a) >= rank(b) ? a : b;
+}
 
 inline double numberArg(const char* tool, const std::string& option, const std::string& text, double min,
                         double max) {

@@ -15,6 +15,7 @@
 #include "sbot_sim/core/yaml_checks.h"
 #include "sbot_sim/core/effects/effect_registry.h"
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/input_file.h"
 #include "sbot_sim/core/output_files.h"
 #include "sbot_sim/core/world_config.h"
 
@@ -104,14 +105,7 @@ std::vector<EffectConfig> parseEffectsConfig(const std::string& yaml_text, const
 }
 
 std::vector<EffectConfig> loadEffectsConfig(const std::string& path) {
-  // A folder opens as a stream that reads nothing, which would be "no effects".
-  struct stat st {};
-  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) throw ConfigError(path, "", "is a folder, not an effects file");
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path, "", "cannot open effects file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseEffectsConfig(ss.str(), path);
+  return parseEffectsConfig(readInputFile(path, "effects file"), path);
 }
 
 std::vector<EffectPtr> makeEffects(const std::vector<EffectConfig>& configs, const std::string& source) {

@@ -14,6 +14,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "sbot_sim/core/errors.h"
+#include "sbot_sim/core/input_file.h"
 #include "sbot_sim/core/output_files.h"
 #include "sbot_sim/core/robot.h"
 #include "sbot_sim/core/robot_description.h"
@@ -198,7 +199,7 @@ void IrLookupTable::save(const std::string& path) const {
 IrLookupTable IrLookupTable::load(const std::string& path) {
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    root = YAML::Load(readInputFile(path, "IR look-up table"));
   } catch (const std::exception& e) {
     throw ConfigError(path, "", std::string("cannot read the IR look-up table: ") + e.what());
   }
