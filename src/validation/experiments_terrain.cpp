@@ -21,16 +21,32 @@ using namespace detail;
 
 // ---- Table 4.2 / 4.5: gap ------------------------------------------------------------------------
 
-TrialWorld gapWorld(const std::string& level, double gap_m, int trial, const Drive& drive) {
+namespace {
+
+/// What a terrain trial's world starts from: the level, its length scale, the trial's start jitter
+/// (named `what` + level) and the level's world, seeded `seed`, its terrain composite.
+struct TrialStart {
+  const RobotDescription& d;
+  double s;  ///< lengthScale(level)
+  Jitter j;
+  TrialWorld t;
+};
+TrialStart trialStart(const std::string& level, const std::string& what, double param, int trial, std::uint64_t seed,
+                      const Drive& drive) {
   const RobotDescription& d = loadLevel(level);
-  const double s = lengthScale(level);
-  Jitter j("gap" + level, gap_m, trial);
-  TrialWorld t{configFor(d, 1000 + trial, drive)};
+  TrialStart st{d, lengthScale(level), Jitter(what + level, param, trial), TrialWorld{configFor(d, seed, drive)}};
+  st.t.world.terrain.type = TerrainConfig::Type::Composite;
+  return st;
+}
+
+}  // namespace
+
+TrialWorld gapWorld(const std::string& level, double gap_m, int trial, const Drive& drive) {
+  auto [d, s, j, t] = trialStart(level, "gap", gap_m, trial, 1000 + trial, drive);
   const double top = 0.10;
   // The half-size Fast robot crosses the gap halved, as its terrain is halved in 4.2.2 "to retain
   // comparable conditions" (the seed's Fast passing 6 cm, longer than itself, needs it too).
   const double gap = gap_m * s;
-  t.world.terrain.type = TerrainConfig::Type::Composite;
   addBlock(t.world.terrain.boxes, -1.0 - gap / 2, -gap / 2, top, "near_side");
   addBlock(t.world.terrain.boxes, gap / 2, 1.0 + gap / 2, top, "far_side");
   const double x0 = -gap / 2 - 0.075 * s + j.uniform(-0.005, 0.005) * s;
@@ -88,11 +104,8 @@ Outcome gapTrial(const std::string& level, double gap_m, int trial, const Drive&
 // ---- Table 4.3: step ------------------------------------------------------------------------------
 
 TrialWorld stepWorld(const std::string& level, double height_m, bool backward, int trial, const Drive& drive) {
-  const RobotDescription& d = loadLevel(level);
-  const double s = lengthScale(level);
-  Jitter j(std::string("step") + (backward ? "b" : "f") + level, height_m, trial);
-  TrialWorld t{configFor(d, 2000 + trial, drive)};
-  t.world.terrain.type = TerrainConfig::Type::Composite;
+  auto [d, s, j, t] =
+      trialStart(level, std::string("step") + (backward ? "b" : "f"), height_m, trial, 2000 + trial, drive);
   addBlock(t.world.terrain.boxes, 0.0, 1.0, height_m * s, "step");  // halved for Fast, as its gaps
   const double x0 = -0.075 * s + j.uniform(-0.005, 0.005) * s;
   const double yaw = (backward ? M_PI : 0.0) + j.uniform(-0.03, 0.03);
@@ -176,11 +189,7 @@ Outcome slopeHoldClimbTrial(const std::string& level, double angle_rad, bool bac
 // ---- Table 4.6: uphill ramp from flat ground -----------------------------------------------------
 
 TrialWorld uphillWorld(const std::string& level, double angle_rad, int trial, const Drive& drive) {
-  const RobotDescription& d = loadLevel(level);
-  const double s = lengthScale(level);
-  Jitter j("uphill" + level, angle_rad, trial);
-  TrialWorld t{configFor(d, 4000 + trial, drive)};
-  t.world.terrain.type = TerrainConfig::Type::Composite;
+  auto [d, s, j, t] = trialStart(level, "uphill", angle_rad, trial, 4000 + trial, drive);
   t.world.terrain.boxes.push_back(ramp(Vec3(0, 0, 0), angle_rad, 0.6 * s, "ramp"));
   const double yaw0 = j.uniform(-0.05, 0.05);
   t.start = {-0.12 * s + j.uniform(-0.01, 0.01) * s, j.uniform(-0.01, 0.01) * s, yaw0};
@@ -258,11 +267,7 @@ double downhillRampLength(double s) { return 0.4 * s; }
 }  // namespace
 
 TrialWorld downhillWorld(const std::string& level, double angle_rad, int trial, const Drive& drive) {
-  const RobotDescription& d = loadLevel(level);
-  const double s = lengthScale(level);
-  Jitter j("downhill" + level, angle_rad, trial);
-  TrialWorld t{configFor(d, 5000 + trial, drive)};
-  t.world.terrain.type = TerrainConfig::Type::Composite;
+  auto [d, s, j, t] = trialStart(level, "downhill", angle_rad, trial, 5000 + trial, drive);
   const double L = downhillRampLength(s);
   const double H = L * std::sin(angle_rad);
   addBlock(t.world.terrain.boxes, -1.0, 0.0, H, "plateau");
