@@ -63,12 +63,14 @@ struct StartedTrial {
   World world;
   Robot& robot;
   double z0;  ///< [m] the base's height after standing
+  double h0;  ///< [rad] the heading after standing
   StartedTrial(const TrialWorld& t, const RobotDescription& d)
       : world(t.world), robot(spawn(world, d, t.start)) {
     robot.setSpeed(0, 0);
     world.stepN(static_cast<int>(t.settle / t.world.step));
     z0 = robot.basePose().position.z();
     robot.setSpeed(t.units, t.units);
+    h0 = headingOf(robot);
   }
 };
 
@@ -205,7 +207,6 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial, const
   StartedTrial st(t, d);
   World& w = st.world;
   Robot& r = st.robot;
-  const double h0 = headingOf(r);
   const double z0 = st.z0;
   const Vec3 normal(-std::sin(angle_rad), 0, std::cos(angle_rad));
   double best = 0;
@@ -241,7 +242,7 @@ Outcome uphillTrial(const std::string& level, double angle_rad, int trial, const
     if (along() > 0.25 * s) { o.label = "climb"; return true; }
     return false;
   });
-  const double dh = headingChangeSince(r, h0);
+  const double dh = headingChangeSince(r, st.h0);
   o.value = best;
   o.value2 = dh;
   if (o.label == "stuck") {
@@ -286,7 +287,6 @@ Outcome downhillTrial(const std::string& level, double angle_rad, int trial, con
   StartedTrial st(t, d);
   World& w = st.world;
   Robot& r = st.robot;
-  const double h0 = headingOf(r);
   Outcome o{"stuck"};
   const double foot = L * std::cos(angle_rad), goal = foot + 0.10 * s;
   const Vec3 ramp_normal(std::sin(angle_rad), 0, std::cos(angle_rad));  // the ramp falls toward +x
@@ -307,7 +307,7 @@ Outcome downhillTrial(const std::string& level, double angle_rad, int trial, con
     return false;
   });
   o.value = r.basePose().position.x();
-  o.value2 = headingChangeSince(r, h0);
+  o.value2 = headingChangeSince(r, st.h0);
   // Short of the goal, upright, but turned off its course (e.g. slewed across the ramp at the
   // plateau's edge and driving along it): that robot changed course; it is not stuck.
   if (o.label == "stuck" && o.value2 > kCourseChange) o.label = "c/c";
