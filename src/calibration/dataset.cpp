@@ -1,18 +1,15 @@
+// The dataset: dataset.yaml (its world, noise and runs sections), the types over it, and writing it
+// back. The runs' CSV files are read by dataset_csv.cpp.
 #include "calibration/dataset.h"
 
 #include <sys/stat.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <climits>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <iomanip>
-#include <regex>
 #include <sstream>
-#include <tuple>
 #include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
@@ -22,12 +19,15 @@
 #include "sbot_sim/core/output_files.h"
 #include "sbot_sim/core/robot_description.h"
 #include "sbot_sim/core/scenario.h"
-#include "sbot_sim/core/world.h"  // positionProblem, kMaxCoordinate
+#include "sbot_sim/core/world.h"  // positionProblem
 #include "sbot_sim/core/yaml_checks.h"
 
-#include "calibration/sensor_bridge.h"  // SensorBridge::supports
+#include "calibration/dataset_internal.h"
 
 namespace sbot::calib {
+using detail::channelRangeProblem;
+using detail::fmtNumber;
+
 namespace {
 
 /// A column name as a message shows it: at most 40 characters (a header that is one 10 kB cell).
@@ -41,30 +41,6 @@ std::string location(const std::string& file, int line, int column, const std::s
   return s;
 }
 
-/// The first byte no text CSV holds: NUL, or a control character other than tab, CR and LF
-/// (binary and compressed files have them within their first bytes). Bytes >= 0x80 pass: a Latin-1
-/// comment in a user column is still text.
-struct NonTextByte {
-  int line = 0;            ///< 1-based; 0: none found
-  std::size_t byte = 0;    ///< 1-based within its line
-  unsigned char value = 0;
-};
-NonTextByte firstNonTextByte(const std::string& text) {
-  NonTextByte b{1, 0, 0};
-  std::size_t line_start = 0;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const unsigned char c = static_cast<unsigned char>(text[i]);
-    if (c == '\n') {
-      ++b.line;
-      line_start = i + 1;
-    } else if ((c < 0x20 && c != '\t' && c != '\r') || c == 0x7f) {
-      b.byte = i - line_start + 1;
-      b.value = c;
-      return b;
-    }
-  }
-  return {};
-}
 
 [[noreturn]] void fail(const std::string& file, const YAML::Node& n, const std::string& field, const std::string& what) {
   const YAML::Mark m = n.IsDefined() ? n.Mark() : YAML::Mark::null_mark();
@@ -92,12 +68,6 @@ bool isDirectory(const std::string& p) {
   return stat(p.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
 }
 
-std::string trim(const std::string& s) {
-  std::size_t a = 0, b = s.size();
-  while (a < b && std::isspace(static_cast<unsigned char>(s[a]))) ++a;
-  while (b > a && std::isspace(static_cast<unsigned char>(s[b - 1]))) --b;
-  return s.substr(a, b - a);
-}
 
 double number(const YAML::Node& n, const std::string& file, const std::string& field) {
   double v;
@@ -126,44 +96,8 @@ std::string defaultGroup(const std::string& name) {
   return u == std::string::npos ? name : name.substr(0, u);
 }
 
-std::string fmtNumber(double v) {
-  std::ostringstream o;
-  o << v;
-  return o.str();
-}
-
-/// Why a measured value cannot be a reading of its channel ("" if it can): the sensors' documented
-/// ranges (docs/calibration.md), and for the rest bounds no s-bot reaches, so that a unit mistake or
-/// a corrupt cell is named instead of dominating every error figure.
-std::string channelRangeProblem(const std::string& channel, double v) {
-  const std::string g = NoiseModel::group(channel);
-  double lo = 0, hi = 0;
-  std::string unit;
-  if (g == "ir") hi = 8191;
-  else if (g == "ground") hi = 255;
-  else if (g == "light") hi = 700;
-  else if (g == "position") lo = -kMaxCoordinate, hi = kMaxCoordinate, unit = " m";
-  else if (g == "yaw" || g == "tilt") lo = -1000, hi = 1000, unit = " rad";  // unwrapped angles may run on
-  else if (g == "speed" || g == "torque") lo = -1000, hi = 1000, unit = " API units";
-  else return "";
-  if (v >= lo && v <= hi) return "";
-  return "value " + fmtNumber(v) + " outside the range of " + channel + " [" + fmtNumber(lo) + ", " + fmtNumber(hi) +
-         "]" + unit;
-}
-
 /// [s] the latest start of a run in its session (Run::start_time): 10 days.
 constexpr double kMaxStartTime = 864000;
-
-bool parseNumber(const std::string& cell, double& out) {
-  if (cell.empty()) return false;
-  const char* b = cell.c_str();
-  char* e = nullptr;
-  errno = 0;
-  out = std::strtod(b, &e);
-  // strtod also reads hexadecimal ("0x10" = 16), which no measurement file means.
-  if (cell.find_first_of("xX") != std::string::npos) return false;
-  return e != b && e == b + cell.size();  // the whole cell: not up to a NUL byte inside it
-}
 
 }  // namespace
 
@@ -299,262 +233,11 @@ Dataset withoutRuns(const Dataset& ds, const std::set<std::string>& skip) {
   return kept;
 }
 
-bool isKnownColumn(const std::string& c) {
-  static const std::set<std::string> fixed{"t",           "cmd_left",     "cmd_right",   "x",        "y",
-                                           "yaw",         "z",            "speed_left",  "speed_right",
-                                           "torque_left", "torque_right", "pitch",       "roll",
-                                           "force_x",     "force_y",      "passive"};
-  if (fixed.count(c)) return true;
-  static const std::regex indexed("(ir([0-9]|1[0-4])|ground[0-3]|light[0-7])");
-  return std::regex_match(c, indexed);
-}
-
-namespace {
-/// Why a drive run's times look like milliseconds (or its positions like kilometres) although each
-/// row gap and the run's length passed their limits ("" if nothing does): rows a second or more
-/// apart (a tracker at under 1 Hz) and a robot that moved under 1/100 of what its commands ask for.
-/// Either alone is possible (a slow logger; a robot pushing a wall); together they are a 1000x
-/// stretched time axis, which the replay would simulate for hours.
-std::string timeUnitProblem(const Run& run, std::vector<double> row_gaps) {
-  // The seed's API speed unit, 2.8 mm/s (Fast's is half: the 100x margin covers every level).
-  constexpr double kNominalSpeedUnit = 0.0028;  // [m/s]
-  const auto x = run.channels.find("x"), y = run.channels.find("y");
-  if (row_gaps.empty() || x == run.channels.end() || y == run.channels.end() || x->second.v.size() < 2 ||
-      x->second.v.size() != y->second.v.size())
-    return "";
-  std::nth_element(row_gaps.begin(), row_gaps.begin() + row_gaps.size() / 2, row_gaps.end());
-  const double median_gap = row_gaps[row_gaps.size() / 2];
-  if (median_gap < 1.0) return "";
-  double asked = 0;  // [m] the forward distance the commands ask for, where the tracks are driven
-  for (std::size_t i = 0; i < run.cmd_t.size(); ++i) {
-    const double until = i + 1 < run.cmd_t.size() ? run.cmd_t[i + 1] : run.t_end;
-    if (run.passiveAt(run.cmd_t[i])) continue;
-    asked += std::abs(0.5 * (run.cmd_left[i] + run.cmd_right[i])) * kNominalSpeedUnit *
-             std::max(0.0, until - std::max(0.0, run.cmd_t[i]));
-  }
-  const Series &sx = x->second, &sy = y->second;
-  const double moved = std::hypot(sx.v.back() - sx.v.front(), sy.v.back() - sy.v.front());  // [m]
-  double path = 0;  // [m] along the samples (noise only lengthens it)
-  for (std::size_t i = 1; i < sx.v.size(); ++i) path += std::hypot(sx.v[i] - sx.v[i - 1], sy.v[i] - sy.v[i - 1]);
-  if (asked < 0.05 || path * 100 >= asked) return "";
-  return "rows " + fmtNumber(median_gap) + " s apart (median) and the robot moved " + fmtNumber(moved) + " m (" +
-         fmtNumber(path) + " m along its samples) in " + fmtNumber(run.t_end) +
-         " s where its commands ask for about " + fmtNumber(asked) +
-         " m: are the times in milliseconds? (t must be in seconds, x and y in metres)";
-}
-}  // namespace
-
-void parseRunCsv(const std::string& text, const std::string& file, Run& run) {
-  // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first column's name.
-  const bool bom = text.rfind("\xEF\xBB\xBF", 0) == 0;
-  if (const NonTextByte b = firstNonTextByte(text); b.line > 0) {
-    char hex[8];
-    std::snprintf(hex, sizeof hex, "0x%02x", b.value);
-    throw DatasetError(file, b.line, 0, "", "not a text CSV file: byte " + std::to_string(b.byte) + " of the line is " +
-                                                hex + ", a control character no text holds (a binary or compressed file?)");
-  }
-  std::istringstream in(bom ? text.substr(3) : text);
-  std::string raw;
-  int line_no = 0;
-  std::vector<std::string> header;
-  int header_line = 0;
-  while (std::getline(in, raw)) {
-    ++line_no;
-    if (!raw.empty() && raw.back() == '\r') raw.pop_back();
-    const std::string t = trim(raw);
-    if (t.empty() || t[0] == '#') continue;
-    std::stringstream ss(t);
-    for (std::string cell; std::getline(ss, cell, ',');) header.push_back(trim(cell));
-    if (!t.empty() && t.back() == ',') header.push_back("");
-    header_line = line_no;
-    break;
-  }
-  if (header.empty()) throw DatasetError(file, 0, 0, "", "empty file: expected a header line with column names");
-  std::map<std::string, int> col;
-  for (std::size_t i = 0; i < header.size(); ++i) {
-    const std::string& h = header[i];
-    if (h.empty()) throw DatasetError(file, header_line, i + 1, "", "empty column name in the header");
-    if (h[0] == '_') continue;  // user columns (comments, annotations) are ignored
-    if (!isKnownColumn(h))
-      throw DatasetError(file, header_line, i + 1, h,
-                         "unknown column (expected t, cmd_left, cmd_right, x, y, yaw, speed_left, speed_right, "
-                         "torque_left, torque_right, pitch, roll, ir0..ir14, ground0..ground3, light0..light7; "
-                         "prefix user columns with '_')");
-    if (col.count(h)) throw DatasetError(file, header_line, i + 1, h, "column appears twice");
-    col[h] = static_cast<int>(i);
-  }
-  auto need = [&](const std::string& c) {
-    if (col.count(c)) return;
-    std::string have;
-    for (const auto& h : header) have += (have.empty() ? "" : ", ") + h;
-    throw DatasetError(file, header_line, 0, c,
-                       "missing column '" + c + "' (a " + (run.kind == RunKind::Drive ? "drive" : "place") +
-                           " run needs " + (run.kind == RunKind::Drive ? "t, cmd_left, cmd_right" : "x, y, yaw") +
-                           "; the header has " + have + ")");
-  };
-  const bool drive = run.kind == RunKind::Drive;
-  if (drive) {
-    need("t");
-    need("cmd_left");
-    need("cmd_right");
-  } else {
-    need("x");
-    need("y");
-    need("yaw");
-  }
-  std::vector<std::string> measured;
-  for (const auto& [c, i] : col) {
-    if (c == "t" || c == "cmd_left" || c == "cmd_right" || c == "force_x" || c == "force_y" || c == "passive") {
-      if (!drive && c != "t")
-        throw DatasetError(file, header_line, i + 1, c, "input columns are only allowed in drive runs");
-      continue;
-    }
-    if (!drive && (c == "x" || c == "y" || c == "yaw" || c == "z")) continue;
-    if (drive && c == "z") throw DatasetError(file, header_line, i + 1, c, "column z is only allowed in place runs");
-    if (!drive && !SensorBridge::supports(NoiseModel::group(c)))
-      throw DatasetError(file, header_line, i + 1, c,
-                         "a place run measures sensors only (ir*, ground*, light*): a robot set down has no " + c);
-    measured.push_back(c);
-  }
-  if (measured.empty())
-    throw DatasetError(file, header_line, 0, "",
-                       drive ? "no measured column (x, y, yaw, speed_*, torque_*, pitch, roll, ir*, ground*, light*)"
-                             : "no sensor column (ir*, ground*, light*, ...)");
-
-  double last_t = -std::numeric_limits<double>::infinity();
-  int last_t_line = 0;
-  double max_gap = 0;  // [s] the longest time between two consecutive rows, and where it ends
-  int max_gap_line = 0;
-  std::vector<double> row_gaps;  // [s] between consecutive rows (timeUnitProblem)
-  int row = 0;
-  while (std::getline(in, raw)) {
-    ++line_no;
-    if (!raw.empty() && raw.back() == '\r') raw.pop_back();
-    const std::string tline = trim(raw);
-    if (tline.empty() || tline[0] == '#') continue;
-    std::vector<std::string> cells;
-    std::stringstream ss(raw);
-    for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(trim(cell));
-    if (!raw.empty() && raw.back() == ',') cells.push_back("");
-    if (cells.size() != header.size())
-      throw DatasetError(file, line_no, 0, "",
-                         "expected " + std::to_string(header.size()) + " cells, found " + std::to_string(cells.size()));
-    auto value = [&](const std::string& c, double& v) -> bool {
-      const int i = col.at(c);
-      const std::string& cell = cells[i];
-      if (cell.empty()) return false;
-      if (!parseNumber(cell, v)) throw DatasetError(file, line_no, i + 1, c, "not a number: '" + cell + "'");
-      if (std::isnan(v)) throw DatasetError(file, line_no, i + 1, c, "NaN (leave the cell empty for 'not measured')");
-      if (!std::isfinite(v)) throw DatasetError(file, line_no, i + 1, c, "infinite value");
-      return true;
-    };
-    double t = row;
-    if (col.count("t")) {
-      if (!value("t", t)) throw DatasetError(file, line_no, col.at("t") + 1, "t", "missing time stamp");
-      if (!(t > last_t))
-        throw DatasetError(file, line_no, col.at("t") + 1, "t",
-                           "time is not increasing (" + std::to_string(t) + " after " + std::to_string(last_t) +
-                               " on line " + std::to_string(last_t_line) + ")");
-      if (row > 0) row_gaps.push_back(t - last_t);
-      if (row > 0 && t - last_t > max_gap) {
-        max_gap = t - last_t;
-        max_gap_line = line_no;
-      }
-      last_t = t;
-      last_t_line = line_no;
-    }
-    if (drive) {
-      double l, r;
-      const bool hl = value("cmd_left", l), hr = value("cmd_right", r);
-      if (hl != hr)
-        throw DatasetError(file, line_no, col.at(hl ? "cmd_right" : "cmd_left") + 1, hl ? "cmd_right" : "cmd_left",
-                           "cmd_left and cmd_right must be given together");
-      if (hl) {
-        for (auto [c, v] : {std::pair<const char*, double>{"cmd_left", l}, {"cmd_right", r}})
-          if (std::abs(v) > 127)
-            throw DatasetError(file, line_no, col.at(c) + 1, c, "command outside the API range [-127, 127]");
-          else if (v != std::round(v))
-            throw DatasetError(file, line_no, col.at(c) + 1, c,
-                               "command " + fmtNumber(v) + " is not a whole number of API units (setSpeed takes integers)");
-        run.cmd_t.push_back(t);
-        run.cmd_left.push_back(l);
-        run.cmd_right.push_back(r);
-      }
-      double fx = 0, fy = 0, pv = 0;
-      const bool hfx = col.count("force_x") && value("force_x", fx);
-      const bool hfy = col.count("force_y") && value("force_y", fy);
-      for (auto [c, v, has] : {std::tuple<const char*, double, bool>{"force_x", fx, hfx}, {"force_y", fy, hfy}})
-        if (has && std::abs(v) > kMaxPullForce)
-          throw DatasetError(file, line_no, col.at(c) + 1, c,
-                             "value " + fmtNumber(v) + " N outside [-" + fmtNumber(kMaxPullForce) + ", " +
-                                 fmtNumber(kMaxPullForce) + "] N (an s-bot weighs 6.6 N: is it in newtons?)");
-      if (hfx || hfy) {
-        auto prev = run.forceAt(t);
-        run.force_t.push_back(t);
-        run.force_x.push_back(hfx ? fx : prev.first);
-        run.force_y.push_back(hfy ? fy : prev.second);
-      }
-      if (col.count("passive") && value("passive", pv)) {
-        if (pv != 0 && pv != 1) throw DatasetError(file, line_no, col.at("passive") + 1, "passive", "expected 0 or 1");
-        run.passive_t.push_back(t);
-        run.passive.push_back(pv);
-      }
-    } else {
-      Placement p;
-      if (!value("x", p.pose.x)) throw DatasetError(file, line_no, col.at("x") + 1, "x", "a placement needs x");
-      if (!value("y", p.pose.y)) throw DatasetError(file, line_no, col.at("y") + 1, "y", "a placement needs y");
-      if (!value("yaw", p.pose.yaw)) throw DatasetError(file, line_no, col.at("yaw") + 1, "yaw", "a placement needs yaw");
-      double z;
-      if (col.count("z") && value("z", z)) p.z = z;
-      run.placements.push_back(p);
-    }
-    for (const auto& c : measured) {
-      double v;
-      if (!value(c, v)) continue;
-      if (drive && t < 0)
-        throw DatasetError(file, line_no, col.at(c) + 1, c,
-                           "measured at t = " + fmtNumber(t) +
-                               " s, before the replay's start at t = 0 (shift the run's times so that it starts at 0)");
-      const std::string range = channelRangeProblem(c, v);
-      if (!range.empty()) throw DatasetError(file, line_no, col.at(c) + 1, c, range);
-      Series& s = run.channels[c];
-      s.t.push_back(drive ? t : row);
-      s.v.push_back(v);
-      s.line.push_back(line_no);
-    }
-    run.t_end = t;
-    ++row;
-  }
-  if (row == 0) throw DatasetError(file, header_line, 0, "", "no data rows");
-  if (drive && run.cmd_t.empty()) throw DatasetError(file, header_line, 0, "cmd_left", "no command in any row");
-  if (drive && run.t_end > kMaxRunDuration)
-    throw DatasetError(file, last_t_line, col.at("t") + 1, "t",
-                       "the run ends at t = " + fmtNumber(run.t_end) + " s; runs longer than " +
-                           fmtNumber(kMaxRunDuration) + " s are refused (the replay simulates every step): are the times in seconds?");
-  if (drive && max_gap > kMaxRowGap)
-    throw DatasetError(file, max_gap_line, col.at("t") + 1, "t",
-                       "a gap of " + fmtNumber(max_gap) + " s since the previous row; gaps over " + fmtNumber(kMaxRowGap) +
-                           " s are refused (the replay would simulate them blind): are the times in seconds?");
-  if (drive)
-    if (const std::string problem = timeUnitProblem(run, row_gaps); !problem.empty())
-      throw DatasetError(file, last_t_line, col.at("t") + 1, "t", problem);
-  if (run.sampleCount() == 0)
-    throw DatasetError(file, header_line, 0, "", "no measured value in any row: nothing to compare the model with");
-  for (const auto& c : measured)
-    if (!run.channels.count(c)) run.channels[c] = Series{};  // declared but never measured: kept empty
-}
-
 namespace {
 
-Dataset loadDatasetFields(const std::string& path_in) {
-  std::string yaml_path = path_in;
-  if (isDirectory(path_in)) yaml_path = path_in + (path_in.back() == '/' ? "" : "/") + "dataset.yaml";
-  Dataset ds;
-  ds.yaml_path = yaml_path;
-  const auto slash = yaml_path.find_last_of('/');
-  ds.dir = slash == std::string::npos ? "." : yaml_path.substr(0, slash);
-  const std::string& f = yaml_path;
-  const std::string text = readFile(yaml_path, "", YAML::Node());
+/// The parsed top-level mapping of dataset.yaml, refused unless it is valid YAML and a mapping.
+YAML::Node readRoot(const std::string& f) {
+  const std::string text = readFile(f, "", YAML::Node());
   YAML::Node root;
   try {
     root = YAML::Load(text);
@@ -563,6 +246,11 @@ Dataset loadDatasetFields(const std::string& path_in) {
   }
   if (const std::string problem = yamlStructureProblem(root); !problem.empty()) throw DatasetError(f, 0, 0, "", problem);
   if (!root.IsMap()) throw DatasetError(f, 1, 1, "", "expected a mapping at the top level");
+  return root;
+}
+
+/// format, name, description, robot and the alignment fields.
+void loadHeaderFields(const YAML::Node& root, const std::string& f, Dataset& ds) {
   allowOnly(root, f, "", {"format", "name", "description", "robot", "world", "noise", "runs", "surfaces",
                           "align_initial_pose", "align_segment", "generator"});
   if (!root["format"]) fail(f, root, "format", "missing (expected 'format: sbot-dataset/1')");
@@ -584,103 +272,159 @@ Dataset loadDatasetFields(const std::string& path_in) {
            "must be 0 (align the start only) or at least " + fmtNumber(kMinAlignSegment) +
                " s: shorter segments re-anchor the model so often that they hide its error");
   }
+}
 
-  std::set<std::string> surfaces = knownSurfaces();
-  if (const YAML::Node s = root["surfaces"]) {
-    if (!s.IsSequence()) fail(f, s, "surfaces", "expected a list of extra surface labels");
-    for (const auto& l : s) surfaces.insert(l.as<std::string>());
+/// world.obstacles: boxes on the known surfaces.
+void loadObstacles(const YAML::Node& obs, const std::string& f, const std::set<std::string>& surfaces, Dataset& ds) {
+  if (!obs.IsSequence()) fail(f, obs, "world.obstacles", "expected a list");
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    const std::string field = "world.obstacles[" + std::to_string(i) + "]";
+    const YAML::Node o = obs[i];
+    if (!o.IsMap()) fail(f, o, field, "expected a mapping {name, center, size, yaw, surface}");
+    allowOnly(o, f, field, {"name", "center", "size", "yaw", "pitch", "surface"});
+    BoxObstacle b;
+    b.name = o["name"] ? o["name"].as<std::string>() : "obstacle_" + std::to_string(i);
+    if (!o["center"]) fail(f, o, field + ".center", "missing");
+    if (!o["size"]) fail(f, o, field + ".size", "missing");
+    b.center = vec3(o["center"], f, field + ".center");
+    b.size = vec3(o["size"], f, field + ".size");
+    if ((b.size.array() <= 0).any()) fail(f, o["size"], field + ".size", "every edge must be > 0");
+    b.yaw = o["yaw"] ? number(o["yaw"], f, field + ".yaw") : 0.0;
+    b.pitch = o["pitch"] ? number(o["pitch"], f, field + ".pitch") : 0.0;
+    b.surface = o["surface"] ? o["surface"].as<std::string>() : "wall";
+    if (!surfaces.count(b.surface)) {
+      fail(f, o["surface"] ? o["surface"] : o, field + ".surface",
+           "unknown surface '" + b.surface + "' (known: " + nameList(surfaces) + "; declare others under 'surfaces:')");
+    }
+    ds.world.terrain.boxes.push_back(b);
   }
+}
 
-  // World: scenario syntax for step/contact/terrain (parsed by the core's scenario parser), plus
-  // obstacles, lamps and ambient light.
-  if (const YAML::Node w = root["world"]) {
-    if (!w.IsMap()) fail(f, w, "world", "expected a mapping");
-    allowOnly(w, f, "world", {"step", "gravity", "solver", "solver_iterations", "solver_sor", "sleep_at_rest", "contact",
-                              "terrain", "obstacles", "lamps", "ambient_light"});
-    YAML::Node scenario;
-    YAML::Node sw;
-    sw["sleep_at_rest"] = false;  // the workbench's default (Dataset::world)
-    for (const char* k : {"step", "gravity", "solver", "solver_iterations", "solver_sor", "sleep_at_rest", "contact",
-                          "terrain"})
-      if (w[k]) sw[k] = w[k];
-    scenario["world"] = sw;
-    try {
-      ds.world = parseScenario(YAML::Dump(scenario), f).world;
-    } catch (const ConfigError& e) {
-      // The scenario parser's message starts with the file we gave it: keep one copy of it.
-      std::string what = e.what();
-      if (what.rfind(f + ": ", 0) == 0) what = what.substr(f.size() + 2);
-      throw DatasetError(f, w.Mark().line + 1, w.Mark().column + 1, "", what);
-    }
-    ds.world_sets_step = static_cast<bool>(w["step"]);
-    ds.world_sets_gravity = static_cast<bool>(w["gravity"]);
-    if (ds.world_sets_gravity) {
-      const std::string problem = gravityProblem(loadLevel(ds.robot), ds.world.gravity);
-      if (!problem.empty()) fail(f, w["gravity"], "world.gravity", problem);
-    }
-    for (const auto& b : ds.world.terrain.boxes)
-      if (!surfaces.count(b.surface)) fail(f, w["terrain"], "world.terrain.boxes", "unknown surface '" + b.surface + "'");
-    if (const YAML::Node obs = w["obstacles"]) {
-      if (!obs.IsSequence()) fail(f, obs, "world.obstacles", "expected a list");
-      for (std::size_t i = 0; i < obs.size(); ++i) {
-        const std::string field = "world.obstacles[" + std::to_string(i) + "]";
-        const YAML::Node o = obs[i];
-        if (!o.IsMap()) fail(f, o, field, "expected a mapping {name, center, size, yaw, surface}");
-        allowOnly(o, f, field, {"name", "center", "size", "yaw", "pitch", "surface"});
-        BoxObstacle b;
-        b.name = o["name"] ? o["name"].as<std::string>() : "obstacle_" + std::to_string(i);
-        if (!o["center"]) fail(f, o, field + ".center", "missing");
-        if (!o["size"]) fail(f, o, field + ".size", "missing");
-        b.center = vec3(o["center"], f, field + ".center");
-        b.size = vec3(o["size"], f, field + ".size");
-        if ((b.size.array() <= 0).any()) fail(f, o["size"], field + ".size", "every edge must be > 0");
-        b.yaw = o["yaw"] ? number(o["yaw"], f, field + ".yaw") : 0.0;
-        b.pitch = o["pitch"] ? number(o["pitch"], f, field + ".pitch") : 0.0;
-        b.surface = o["surface"] ? o["surface"].as<std::string>() : "wall";
-        if (!surfaces.count(b.surface)) {
-          fail(f, o["surface"] ? o["surface"] : o, field + ".surface",
-               "unknown surface '" + b.surface + "' (known: " + nameList(surfaces) + "; declare others under 'surfaces:')");
-        }
-        ds.world.terrain.boxes.push_back(b);
-      }
-    }
-    if (const YAML::Node lamps = w["lamps"]) {
-      if (!lamps.IsSequence()) fail(f, lamps, "world.lamps", "expected a list");
-      for (std::size_t i = 0; i < lamps.size(); ++i) {
-        const std::string field = "world.lamps[" + std::to_string(i) + "]";
-        allowOnly(lamps[i], f, field, {"name", "position", "intensity"});
-        Lamp l;
-        if (!lamps[i]["position"]) fail(f, lamps[i], field + ".position", "missing");
-        l.position = vec3(lamps[i]["position"], f, field + ".position");
-        const std::string where = positionProblem(l.position);
-        if (!where.empty()) fail(f, lamps[i]["position"], field + ".position", where);
-        l.intensity = lamps[i]["intensity"] ? number(lamps[i]["intensity"], f, field + ".intensity") : 0.0;
-        if (l.intensity < 0) fail(f, lamps[i]["intensity"], field + ".intensity", "must be >= 0");
-        ds.lamps.push_back(l);
-      }
-    }
-    if (w["ambient_light"]) ds.ambient_light = number(w["ambient_light"], f, "world.ambient_light");
+/// world.lamps: positions in the world, intensities >= 0.
+void loadLamps(const YAML::Node& lamps, const std::string& f, Dataset& ds) {
+  if (!lamps.IsSequence()) fail(f, lamps, "world.lamps", "expected a list");
+  for (std::size_t i = 0; i < lamps.size(); ++i) {
+    const std::string field = "world.lamps[" + std::to_string(i) + "]";
+    allowOnly(lamps[i], f, field, {"name", "position", "intensity"});
+    Lamp l;
+    if (!lamps[i]["position"]) fail(f, lamps[i], field + ".position", "missing");
+    l.position = vec3(lamps[i]["position"], f, field + ".position");
+    const std::string where = positionProblem(l.position);
+    if (!where.empty()) fail(f, lamps[i]["position"], field + ".position", where);
+    l.intensity = lamps[i]["intensity"] ? number(lamps[i]["intensity"], f, field + ".intensity") : 0.0;
+    if (l.intensity < 0) fail(f, lamps[i]["intensity"], field + ".intensity", "must be >= 0");
+    ds.lamps.push_back(l);
   }
+}
 
-  if (const YAML::Node n = root["noise"]) {
-    if (!n.IsMap()) fail(f, n, "noise", "expected a mapping group: sigma or group: {abs, rel}");
-    for (const auto& kv : n) {
-      const std::string g = kv.first.as<std::string>();
-      if (!ds.noise.table.count(g))
-        fail(f, kv.first, "noise." + g, "unknown channel group (position, yaw, speed, torque, tilt, ir, ground, light)");
-      if (kv.second.IsMap()) {
-        allowOnly(kv.second, f, "noise." + g, {"abs", "rel"});
-        ds.noise.table[g] = {kv.second["abs"] ? number(kv.second["abs"], f, "noise." + g + ".abs") : 0.0,
-                             kv.second["rel"] ? number(kv.second["rel"], f, "noise." + g + ".rel") : 0.0};
-      } else {
-        ds.noise.table[g] = {number(kv.second, f, "noise." + g), 0.0};
-      }
-      const auto& v = ds.noise.table[g];
-      if (v.first < 0 || v.second < 0 || v.first + v.second <= 0)
-        fail(f, kv.second, "noise." + g, "noise scales must be >= 0 and not both zero");
-    }
+/// World: scenario syntax for step/contact/terrain (parsed by the core's scenario parser), plus
+/// obstacles, lamps and ambient light.
+void loadWorld(const YAML::Node& w, const std::string& f, const std::set<std::string>& surfaces, Dataset& ds) {
+  if (!w.IsMap()) fail(f, w, "world", "expected a mapping");
+  allowOnly(w, f, "world", {"step", "gravity", "solver", "solver_iterations", "solver_sor", "sleep_at_rest", "contact",
+                            "terrain", "obstacles", "lamps", "ambient_light"});
+  YAML::Node scenario;
+  YAML::Node sw;
+  sw["sleep_at_rest"] = false;  // the workbench's default (Dataset::world)
+  for (const char* k : {"step", "gravity", "solver", "solver_iterations", "solver_sor", "sleep_at_rest", "contact",
+                        "terrain"})
+    if (w[k]) sw[k] = w[k];
+  scenario["world"] = sw;
+  try {
+    ds.world = parseScenario(YAML::Dump(scenario), f).world;
+  } catch (const ConfigError& e) {
+    // The scenario parser's message starts with the file we gave it: keep one copy of it.
+    std::string what = e.what();
+    if (what.rfind(f + ": ", 0) == 0) what = what.substr(f.size() + 2);
+    throw DatasetError(f, w.Mark().line + 1, w.Mark().column + 1, "", what);
   }
+  ds.world_sets_step = static_cast<bool>(w["step"]);
+  ds.world_sets_gravity = static_cast<bool>(w["gravity"]);
+  if (ds.world_sets_gravity) {
+    const std::string problem = gravityProblem(loadLevel(ds.robot), ds.world.gravity);
+    if (!problem.empty()) fail(f, w["gravity"], "world.gravity", problem);
+  }
+  for (const auto& b : ds.world.terrain.boxes)
+    if (!surfaces.count(b.surface)) fail(f, w["terrain"], "world.terrain.boxes", "unknown surface '" + b.surface + "'");
+  if (const YAML::Node obs = w["obstacles"]) loadObstacles(obs, f, surfaces, ds);
+  if (const YAML::Node lamps = w["lamps"]) loadLamps(lamps, f, ds);
+  if (w["ambient_light"]) ds.ambient_light = number(w["ambient_light"], f, "world.ambient_light");
+}
 
+/// noise: group: sigma or group: {abs, rel}.
+void loadNoise(const YAML::Node& n, const std::string& f, Dataset& ds) {
+  if (!n.IsMap()) fail(f, n, "noise", "expected a mapping group: sigma or group: {abs, rel}");
+  for (const auto& kv : n) {
+    const std::string g = kv.first.as<std::string>();
+    if (!ds.noise.table.count(g))
+      fail(f, kv.first, "noise." + g, "unknown channel group (position, yaw, speed, torque, tilt, ir, ground, light)");
+    if (kv.second.IsMap()) {
+      allowOnly(kv.second, f, "noise." + g, {"abs", "rel"});
+      ds.noise.table[g] = {kv.second["abs"] ? number(kv.second["abs"], f, "noise." + g + ".abs") : 0.0,
+                           kv.second["rel"] ? number(kv.second["rel"], f, "noise." + g + ".rel") : 0.0};
+    } else {
+      ds.noise.table[g] = {number(kv.second, f, "noise." + g), 0.0};
+    }
+    const auto& v = ds.noise.table[g];
+    if (v.first < 0 || v.second < 0 || v.first + v.second <= 0)
+      fail(f, kv.second, "noise." + g, "noise scales must be >= 0 and not both zero");
+  }
+}
+
+/// A run's file, name (a plain file name, unique in the dataset) and kind.
+void loadRunIdentity(const YAML::Node& r, const std::string& f, const std::string& field, std::set<std::string>& names,
+                     Run& run) {
+  if (!r["file"]) fail(f, r, field + ".file", "missing");
+  run.file = r["file"].as<std::string>();
+  if (run.file.empty()) fail(f, r["file"], field + ".file", "empty file name");
+  if (r["name"]) {
+    run.name = r["name"].as<std::string>();
+  } else {  // the file's name without its folders and extension
+    const std::string base = run.file.substr(run.file.find_last_of('/') + 1);
+    run.name = base.substr(0, base.find_last_of('.'));
+  }
+  // The name becomes a file name in the reports (data/<version>/<name>.csv).
+  if (run.name.empty() || run.name == "." || run.name == ".." || run.name.find_first_of("/\\") != std::string::npos)
+    fail(f, r["name"] ? r["name"] : r["file"], field + ".name",
+         "run name '" + run.name + "' must be a plain file name (not empty, no '/' or '\\')");
+  if (!names.insert(run.name).second) fail(f, r["name"] ? r["name"] : r, field + ".name", "duplicate run name '" + run.name + "'");
+  const std::string kind = r["kind"] ? r["kind"].as<std::string>() : "drive";
+  if (kind == "drive") run.kind = RunKind::Drive;
+  else if (kind == "place") run.kind = RunKind::Place;
+  else fail(f, r["kind"], field + ".kind", "expected drive or place, found '" + kind + "'");
+}
+
+/// A run's start pose (required for a drive run), group and start time.
+void loadRunStart(const YAML::Node& r, const std::string& f, const std::string& field, Run& run) {
+  if (const YAML::Node p = r["initial_pose"]) {
+    if (!p.IsMap()) fail(f, p, field + ".initial_pose", "expected {x, y, yaw}");
+    allowOnly(p, f, field + ".initial_pose", {"x", "y", "yaw"});
+    for (const char* k : {"x", "y", "yaw"})
+      if (!p[k]) fail(f, p, field + ".initial_pose." + k, "missing (a start pose gives x, y and yaw)");
+    run.initial_pose.x = number(p["x"], f, field + ".initial_pose.x");
+    run.initial_pose.y = number(p["y"], f, field + ".initial_pose.y");
+    run.initial_pose.yaw = number(p["yaw"], f, field + ".initial_pose.yaw");
+    // The measured channels' own bounds (channelRangeProblem): a start the world cannot place was
+    // named only by the first replay, without the file or the field.
+    const std::pair<const char*, double> start[] = {
+        {"x", run.initial_pose.x}, {"y", run.initial_pose.y}, {"yaw", run.initial_pose.yaw}};
+    for (const auto& [k, v] : start)
+      if (const std::string why = channelRangeProblem(k, v); !why.empty()) fail(f, p[k], field + ".initial_pose." + k, why);
+  } else if (run.kind == RunKind::Drive) {
+    fail(f, r, field + ".initial_pose", "missing (a drive run starts from a known pose)");
+  }
+  run.group = r["group"] ? r["group"].as<std::string>() : defaultGroup(run.name);
+  if (r["start_time"]) {
+    run.start_time = number(r["start_time"], f, field + ".start_time");
+    if (run.start_time < 0) fail(f, r["start_time"], field + ".start_time", "must be >= 0");
+    if (run.start_time > kMaxStartTime)  // a battery's time, not a date: 1e300 s drained it at once
+      fail(f, r["start_time"], field + ".start_time",
+           "must be at most " + fmtNumber(kMaxStartTime) + " s (a time in the session, not a date)");
+  }
+}
+
+/// runs: each run's fields, then its CSV file (one file per run).
+void loadRuns(const YAML::Node& root, const std::string& f, Dataset& ds) {
   const YAML::Node runs = root["runs"];
   if (!runs || !runs.IsSequence() || runs.size() == 0) fail(f, runs ? runs : root, "runs", "expected a non-empty list of runs");
   std::set<std::string> names;
@@ -691,49 +435,8 @@ Dataset loadDatasetFields(const std::string& path_in) {
     if (!r.IsMap()) fail(f, r, field, "expected a mapping {name, file, kind, initial_pose}");
     allowOnly(r, f, field, {"name", "file", "kind", "initial_pose", "group", "description", "start_time"});
     Run run;
-    if (!r["file"]) fail(f, r, field + ".file", "missing");
-    run.file = r["file"].as<std::string>();
-    if (run.file.empty()) fail(f, r["file"], field + ".file", "empty file name");
-    if (r["name"]) {
-      run.name = r["name"].as<std::string>();
-    } else {  // the file's name without its folders and extension
-      const std::string base = run.file.substr(run.file.find_last_of('/') + 1);
-      run.name = base.substr(0, base.find_last_of('.'));
-    }
-    // The name becomes a file name in the reports (data/<version>/<name>.csv).
-    if (run.name.empty() || run.name == "." || run.name == ".." || run.name.find_first_of("/\\") != std::string::npos)
-      fail(f, r["name"] ? r["name"] : r["file"], field + ".name",
-           "run name '" + run.name + "' must be a plain file name (not empty, no '/' or '\\')");
-    if (!names.insert(run.name).second) fail(f, r["name"] ? r["name"] : r, field + ".name", "duplicate run name '" + run.name + "'");
-    const std::string kind = r["kind"] ? r["kind"].as<std::string>() : "drive";
-    if (kind == "drive") run.kind = RunKind::Drive;
-    else if (kind == "place") run.kind = RunKind::Place;
-    else fail(f, r["kind"], field + ".kind", "expected drive or place, found '" + kind + "'");
-    if (const YAML::Node p = r["initial_pose"]) {
-      if (!p.IsMap()) fail(f, p, field + ".initial_pose", "expected {x, y, yaw}");
-      allowOnly(p, f, field + ".initial_pose", {"x", "y", "yaw"});
-      for (const char* k : {"x", "y", "yaw"})
-        if (!p[k]) fail(f, p, field + ".initial_pose." + k, "missing (a start pose gives x, y and yaw)");
-      run.initial_pose.x = number(p["x"], f, field + ".initial_pose.x");
-      run.initial_pose.y = number(p["y"], f, field + ".initial_pose.y");
-      run.initial_pose.yaw = number(p["yaw"], f, field + ".initial_pose.yaw");
-      // The measured channels' own bounds (channelRangeProblem): a start the world cannot place was
-      // named only by the first replay, without the file or the field.
-      const std::pair<const char*, double> start[] = {
-          {"x", run.initial_pose.x}, {"y", run.initial_pose.y}, {"yaw", run.initial_pose.yaw}};
-      for (const auto& [k, v] : start)
-        if (const std::string why = channelRangeProblem(k, v); !why.empty()) fail(f, p[k], field + ".initial_pose." + k, why);
-    } else if (run.kind == RunKind::Drive) {
-      fail(f, r, field + ".initial_pose", "missing (a drive run starts from a known pose)");
-    }
-    run.group = r["group"] ? r["group"].as<std::string>() : defaultGroup(run.name);
-    if (r["start_time"]) {
-      run.start_time = number(r["start_time"], f, field + ".start_time");
-      if (run.start_time < 0) fail(f, r["start_time"], field + ".start_time", "must be >= 0");
-      if (run.start_time > kMaxStartTime)  // a battery's time, not a date: 1e300 s drained it at once
-        fail(f, r["start_time"], field + ".start_time",
-             "must be at most " + fmtNumber(kMaxStartTime) + " s (a time in the session, not a date)");
-    }
+    loadRunIdentity(r, f, field, names, run);
+    loadRunStart(r, f, field, run);
     run.path = run.file[0] == '/' ? run.file : ds.dir + "/" + run.file;
     // One file, one run's measurements: a second run naming it (a copy-paste slip) replayed the
     // first run's data from the second's start pose and counted it twice.
@@ -745,6 +448,27 @@ Dataset loadDatasetFields(const std::string& path_in) {
     parseRunCsv(readFile(run.path, f, r["file"]), run.path, run);
     ds.runs.push_back(std::move(run));
   }
+}
+
+Dataset loadDatasetFields(const std::string& path_in) {
+  std::string yaml_path = path_in;
+  if (isDirectory(path_in)) yaml_path = path_in + (path_in.back() == '/' ? "" : "/") + "dataset.yaml";
+  Dataset ds;
+  ds.yaml_path = yaml_path;
+  const auto slash = yaml_path.find_last_of('/');
+  ds.dir = slash == std::string::npos ? "." : yaml_path.substr(0, slash);
+  const std::string& f = yaml_path;
+  const YAML::Node root = readRoot(f);
+  loadHeaderFields(root, f, ds);
+
+  std::set<std::string> surfaces = knownSurfaces();
+  if (const YAML::Node s = root["surfaces"]) {
+    if (!s.IsSequence()) fail(f, s, "surfaces", "expected a list of extra surface labels");
+    for (const auto& l : s) surfaces.insert(l.as<std::string>());
+  }
+  if (const YAML::Node w = root["world"]) loadWorld(w, f, surfaces, ds);
+  if (const YAML::Node n = root["noise"]) loadNoise(n, f, ds);
+  loadRuns(root, f, ds);
   return ds;
 }
 

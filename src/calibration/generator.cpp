@@ -196,33 +196,12 @@ void checkGeneratorOptions(const GeneratorOptions& opt) {
   }
 }
 
-Dataset generateDataset(const GeneratorOptions& opt, WorkerPool& pool, GeneratedTruth* truth) {
-  Dataset ds;
-  ds.name = opt.name;
-  ds.robot = opt.level;
-  ds.world.solver = opt.solver;
-  ds.noise = opt.noise;
-  ds.align_segment = opt.align_segment;
-  ds.description = "synthetic dataset (sbot_calibrate generate, seed " + std::to_string(opt.seed) + ")";
-  loadLevel(opt.level);  // fail early on an unknown level
-  checkGeneratorOptions(opt);
+namespace {
 
-  // The world the "real" robot drives in: the dataset's (flat) world, possibly tilted (gravity).
-  WorldConfig real = ds.world;
-  std::mt19937_64 world_rng(stableHash(opt.seed, "world"));
-  const double tilt_dir = std::uniform_real_distribution<double>(-M_PI, M_PI)(world_rng);
-  if (truth) {
-    truth->hidden = opt.hidden;
-    truth->world = real;
-    truth->tilt_deg = opt.tilt_deg;
-    truth->tilt_direction = tilt_dir;
-  }
-
+/// The drive patterns of the chosen families, repeated, thinned to opt.max_runs.
+std::vector<Pattern> drivePatternList(const GeneratorOptions& opt, const std::set<std::string>& families) {
   // Track width of the level, for nominal 90 degree turns of the square.
   const double width = levelTrackWidth(opt.level);
-
-  std::set<std::string> families = opt.experiments;
-  if (families.empty()) families = {"straight", "spin", "arc", "square", "steps"};
   std::vector<Pattern> patterns;
   for (int rep = 0; rep < std::max(1, opt.repeat); ++rep)
     for (const auto& f : generatorFamilies()) {
@@ -239,11 +218,13 @@ Dataset generateDataset(const GeneratorOptions& opt, WorkerPool& pool, Generated
     for (std::size_t i = 0; i < opt.max_runs; ++i) keep.push_back(patterns[static_cast<std::size_t>(i * stride)]);
     patterns = keep;
   }
+  return patterns;
+}
 
-  // Build the runs (commands, measurement time stamps, true start pose). The runs are recorded one
-  // after the other in one session (battery time), with 20 s between runs to reposition the robot.
+/// The drive runs (commands, measurement time stamps, true start pose). The runs are recorded one
+/// after the other in one session (battery time), with 20 s between runs to reposition the robot.
+void addDriveRuns(const std::vector<Pattern>& patterns, const GeneratorOptions& opt, double& session, Dataset& ds) {
   std::vector<Pose2D> true_start(patterns.size());
-  double session = 0;
   for (std::size_t i = 0; i < patterns.size(); ++i) {
     const Pattern& p = patterns[i];
     std::mt19937_64 rng(stableHash(opt.seed, "run/" + p.name));
@@ -269,89 +250,83 @@ Dataset generateDataset(const GeneratorOptions& opt, WorkerPool& pool, Generated
     run.initial_pose = true_start[i];
     ds.runs.push_back(run);
   }
+}
 
-  if (families.count("place") || families.count("approach")) {
-    for (const auto& w : calibrationWalls())
-      ds.world.terrain.boxes.push_back({"wall_" + w.surface, Vec3(kWallX + 0.01, w.y, 0.05), Vec3(0.02, 2.0, 0.1), 0, 0,
-                                        w.surface});
-    real.terrain.boxes = ds.world.terrain.boxes;
-    if (truth) truth->world = real;
-  }
-
-  // Static IR calibration ("place"): the robot placed in front of the three walls, sensors 2, 7 and
-  // 12 facing the wall at 0-60 deg incidence and 1-16 cm.
-  if (families.count("place")) {
-    const auto ir = levelIrSensors(opt.level);
-    for (const auto& w : calibrationWalls()) {
-      // One run per (surface, sensor), grouped by surface so that every fold sees every surface.
-      constexpr double kClearance = 0.065;  // [m] robot outline around base_link (turret, treels corners)
-      for (int k : {2, 7, 12}) {
-        if (k >= static_cast<int>(ir.size())) continue;
-        Run run;
-        run.name = "place_" + w.surface + "_ir" + std::to_string(k);
-        run.file = run.name + ".csv";
-        run.kind = RunKind::Place;
-        run.group = w.surface;
-        const Vec3 pk = ir[k].first;
-        for (double deg : {0.0, 20.0, 40.0, 60.0}) {
-          const double th = deg * M_PI / 180;
-          for (double dcm : {1.0, 2.0, 3.0, 5.0, 8.0, 12.0, 16.0}) {
-            const double d = dcm / 100;
-            const double yaw = th - ir[k].second;  // sensor axis at angle th to the wall normal (+x)
-            const double c = std::cos(yaw), sn = std::sin(yaw);
-            const double sx = c * pk.x() - sn * pk.y(), sy = sn * pk.x() + c * pk.y();
-            const double bx = kWallX - d * std::cos(th) - sx;
-            const double by = w.y - d * std::sin(th) - sy;
-            if (kWallX - bx < kClearance) continue;  // the robot would be inside the wall
-            run.placements.push_back({{bx, by, yaw}, kNaN});
-          }
-        }
-        for (int q = 0; q < static_cast<int>(ir.size()); ++q) {
-          Series sr;
-          for (std::size_t row = 0; row < run.placements.size(); ++row) {
-            sr.t.push_back(static_cast<double>(row));
-            sr.v.push_back(0);
-            sr.line.push_back(0);
-          }
-          run.channels["ir" + std::to_string(q)] = sr;
-        }
-        run.t_end = static_cast<double>(run.placements.size());
-        ds.runs.push_back(run);
-      }
-    }
-  }
-
-  // IR wall approaches ("approach", drive runs): the robot reverses toward each wall at 2.8 cm/s with
-  // its rear at 0, 20, 40 and 60 deg to the wall normal, from out of IR range until its centre is
-  // 8 cm from the wall (the rear sensors then read from ~3 cm), the IR ring logged all the way.
-  if (families.count("approach")) {
-    const std::size_t n_ir = levelIrSensors(opt.level).size();
-    constexpr double kCommand = -10;   // [units] 2.8 cm/s backwards
-    constexpr double kEndDistance = 0.08;  // [m] base_link to the wall face at the end
-    const double run_t = std::max(1.0, opt.duration - 1.0);
-    const double travel = std::abs(kCommand) * loadLevel(opt.level).treels.speed_unit * run_t;
-    for (const auto& w : calibrationWalls()) {
-      int j = 0;
+/// Static IR calibration ("place"): the robot placed in front of the three walls, sensors 2, 7 and
+/// 12 facing the wall at 0-60 deg incidence and 1-16 cm.
+void addPlaceRuns(const GeneratorOptions& opt, Dataset& ds) {
+  const auto ir = levelIrSensors(opt.level);
+  for (const auto& w : calibrationWalls()) {
+    // One run per (surface, sensor), grouped by surface so that every fold sees every surface.
+    constexpr double kClearance = 0.065;  // [m] robot outline around base_link (turret, treels corners)
+    for (int k : {2, 7, 12}) {
+      if (k >= static_cast<int>(ir.size())) continue;
+      Run run;
+      run.name = "place_" + w.surface + "_ir" + std::to_string(k);
+      run.file = run.name + ".csv";
+      run.kind = RunKind::Place;
+      run.group = w.surface;
+      const Vec3 pk = ir[k].first;
       for (double deg : {0.0, 20.0, 40.0, 60.0}) {
-        const double th = deg * M_PI / 180;  // direction of the rear, from the wall normal
-        const std::string name = "approach_" + w.surface + "_" + std::to_string(static_cast<int>(deg));
-        // Grouped by surface: every fold sees every surface.
-        Run run = driveRun(name, "approach_" + w.surface, ramped({{0.0, {kCommand, kCommand}}, {run_t, {0, 0}}}),
-                           opt.duration, session);
-        session += opt.duration + 20.0;
-        const double lane = -0.45 + 0.3 * j++;  // one lane of the wall per incidence
-        run.initial_pose = {kWallX - kEndDistance - travel * std::cos(th),
-                            w.y + lane - 0.5 * travel * std::sin(th), wrapAngle(th + M_PI)};
-        std::mt19937_64 rng(stableHash(opt.seed, "run/" + run.name));
-        addTracker(run, opt.tracker_hz, rng);
-        addChannel(run, "ir0", opt.sensor_hz, rng);  // the whole ring in one message: same stamps
-        for (std::size_t q = 1; q < n_ir; ++q) run.channels["ir" + std::to_string(q)] = run.channels["ir0"];
-        ds.runs.push_back(run);
+        const double th = deg * M_PI / 180;
+        for (double dcm : {1.0, 2.0, 3.0, 5.0, 8.0, 12.0, 16.0}) {
+          const double d = dcm / 100;
+          const double yaw = th - ir[k].second;  // sensor axis at angle th to the wall normal (+x)
+          const double c = std::cos(yaw), sn = std::sin(yaw);
+          const double sx = c * pk.x() - sn * pk.y(), sy = sn * pk.x() + c * pk.y();
+          const double bx = kWallX - d * std::cos(th) - sx;
+          const double by = w.y - d * std::sin(th) - sy;
+          if (kWallX - bx < kClearance) continue;  // the robot would be inside the wall
+          run.placements.push_back({{bx, by, yaw}, kNaN});
+        }
       }
+      for (int q = 0; q < static_cast<int>(ir.size()); ++q) {
+        Series sr;
+        for (std::size_t row = 0; row < run.placements.size(); ++row) {
+          sr.t.push_back(static_cast<double>(row));
+          sr.v.push_back(0);
+          sr.line.push_back(0);
+        }
+        run.channels["ir" + std::to_string(q)] = sr;
+      }
+      run.t_end = static_cast<double>(run.placements.size());
+      ds.runs.push_back(run);
     }
   }
+}
 
-  // Simulate the "real" robot and measure it.
+/// IR wall approaches ("approach", drive runs): the robot reverses toward each wall at 2.8 cm/s with
+/// its rear at 0, 20, 40 and 60 deg to the wall normal, from out of IR range until its centre is
+/// 8 cm from the wall (the rear sensors then read from ~3 cm), the IR ring logged all the way.
+void addApproachRuns(const GeneratorOptions& opt, double& session, Dataset& ds) {
+  const std::size_t n_ir = levelIrSensors(opt.level).size();
+  constexpr double kCommand = -10;   // [units] 2.8 cm/s backwards
+  constexpr double kEndDistance = 0.08;  // [m] base_link to the wall face at the end
+  const double run_t = std::max(1.0, opt.duration - 1.0);
+  const double travel = std::abs(kCommand) * loadLevel(opt.level).treels.speed_unit * run_t;
+  for (const auto& w : calibrationWalls()) {
+    int j = 0;
+    for (double deg : {0.0, 20.0, 40.0, 60.0}) {
+      const double th = deg * M_PI / 180;  // direction of the rear, from the wall normal
+      const std::string name = "approach_" + w.surface + "_" + std::to_string(static_cast<int>(deg));
+      // Grouped by surface: every fold sees every surface.
+      Run run = driveRun(name, "approach_" + w.surface, ramped({{0.0, {kCommand, kCommand}}, {run_t, {0, 0}}}),
+                         opt.duration, session);
+      session += opt.duration + 20.0;
+      const double lane = -0.45 + 0.3 * j++;  // one lane of the wall per incidence
+      run.initial_pose = {kWallX - kEndDistance - travel * std::cos(th),
+                          w.y + lane - 0.5 * travel * std::sin(th), wrapAngle(th + M_PI)};
+      std::mt19937_64 rng(stableHash(opt.seed, "run/" + run.name));
+      addTracker(run, opt.tracker_hz, rng);
+      addChannel(run, "ir0", opt.sensor_hz, rng);  // the whole ring in one message: same stamps
+      for (std::size_t q = 1; q < n_ir; ++q) run.channels["ir" + std::to_string(q)] = run.channels["ir0"];
+      ds.runs.push_back(run);
+    }
+  }
+}
+
+/// Simulates the "real" robot in `real` and fills every run's channels with its noisy measurements.
+void measureRuns(const GeneratorOptions& opt, const WorldConfig& real, double tilt_dir, WorkerPool& pool, Dataset& ds) {
   ModelSpec truth_model{opt.level, opt.hidden};
   ReplayOptions ro;
   ro.align = false;
@@ -386,6 +361,46 @@ Dataset generateDataset(const GeneratorOptions& opt, WorkerPool& pool, Generated
     run.initial_pose.y += noise.sigma("y", 0) * n01(rng);
     run.initial_pose.yaw = wrapAngle(run.initial_pose.yaw + noise.sigma("yaw", 0) * n01(rng));
   }
+}
+
+}  // namespace
+
+Dataset generateDataset(const GeneratorOptions& opt, WorkerPool& pool, GeneratedTruth* truth) {
+  Dataset ds;
+  ds.name = opt.name;
+  ds.robot = opt.level;
+  ds.world.solver = opt.solver;
+  ds.noise = opt.noise;
+  ds.align_segment = opt.align_segment;
+  ds.description = "synthetic dataset (sbot_calibrate generate, seed " + std::to_string(opt.seed) + ")";
+  loadLevel(opt.level);  // fail early on an unknown level
+  checkGeneratorOptions(opt);
+
+  // The world the "real" robot drives in: the dataset's (flat) world, possibly tilted (gravity).
+  WorldConfig real = ds.world;
+  std::mt19937_64 world_rng(stableHash(opt.seed, "world"));
+  const double tilt_dir = std::uniform_real_distribution<double>(-M_PI, M_PI)(world_rng);
+  if (truth) {
+    truth->hidden = opt.hidden;
+    truth->world = real;
+    truth->tilt_deg = opt.tilt_deg;
+    truth->tilt_direction = tilt_dir;
+  }
+
+  std::set<std::string> families = opt.experiments;
+  if (families.empty()) families = {"straight", "spin", "arc", "square", "steps"};
+  double session = 0;
+  addDriveRuns(drivePatternList(opt, families), opt, session, ds);
+  if (families.count("place") || families.count("approach")) {
+    for (const auto& w : calibrationWalls())
+      ds.world.terrain.boxes.push_back({"wall_" + w.surface, Vec3(kWallX + 0.01, w.y, 0.05), Vec3(0.02, 2.0, 0.1), 0, 0,
+                                        w.surface});
+    real.terrain.boxes = ds.world.terrain.boxes;
+    if (truth) truth->world = real;
+  }
+  if (families.count("place")) addPlaceRuns(opt, ds);
+  if (families.count("approach")) addApproachRuns(opt, session, ds);
+  measureRuns(opt, real, tilt_dir, pool, ds);
   return ds;
 }
 

@@ -173,42 +173,45 @@ Pose2D alignSegments(const Run& run, RunPrediction& p, const NoiseModel& noise, 
   return {corr[0](0), corr[0](1), corr[0](2)};
 }
 
-RunPrediction replayDrive(World& world, const RobotDescription& d, const Dataset& ds, const Run& run,
-                          const Pose2D& start, const ReplayOptions& opt, ContactProbe& probe) {
-  RunPrediction out;
-  Robot& robot = world.addRobot(d, start, "sbot_0");
-  const double dt = world.config().step;
-  const int settle = static_cast<int>(std::round(opt.settle / dt));
-  robot.setTrackSpeeds(0, 0);
-  world.stepN(settle);
-  for (const auto& e : world.effects()) {
-    e->reset();
-    if (auto* sag = dynamic_cast<BatterySagEffect*>(e.get())) sag->setElapsed(robot.name(), run.start_time);
-  }
-
-  // Which channels must be recorded?
-  bool need_speed = false, need_torque = false, need_tilt = false;
-  std::vector<std::string> sensor_channels;
+/// The channels a drive replay records besides the pose: those the run measures, all with keep_trace.
+struct NeededChannels {
+  bool speed = false, torque = false, tilt = false;
+  std::vector<std::string> sensors;  ///< ir*, ground*, light*
+};
+NeededChannels neededChannels(const Run& run, const ReplayOptions& opt) {
+  NeededChannels need;
   for (const auto& [c, s] : run.channels) {
     const std::string g = NoiseModel::group(c);
-    need_speed |= g == "speed";
-    need_torque |= g == "torque";
-    need_tilt |= g == "tilt";
-    if (g == "ir" || g == "ground" || g == "light") sensor_channels.push_back(c);
+    need.speed |= g == "speed";
+    need.torque |= g == "torque";
+    need.tilt |= g == "tilt";
+    if (g == "ir" || g == "ground" || g == "light") need.sensors.push_back(c);
   }
-  need_speed |= opt.keep_trace;
-  need_torque |= opt.keep_trace;
-  need_tilt |= opt.keep_trace;
+  need.speed |= opt.keep_trace;
+  need.torque |= opt.keep_trace;
+  need.tilt |= opt.keep_trace;
+  return need;
+}
 
-  const double su = d.treels.speed_unit, tu = d.treels.torque_unit;
-  const int n = static_cast<int>(std::ceil(run.t_end / dt - 1e-9)) + 1;
+/// Appends the robot's state after each step to a Trace.
+struct TraceRecorder {
+  Robot& robot;
+  const ReplayOptions& opt;
+  const ContactProbe& probe;
+  const NeededChannels& need;
+  double su, tu;  ///< the level's API speed and torque units
   Trace tr;
-  auto reserve = [n](std::vector<double>& v) { v.reserve(n + 1); };
-  for (auto* v : {&tr.t, &tr.x, &tr.y, &tr.yaw, &tr.v, &tr.w, &tr.speed_left, &tr.speed_right, &tr.torque_left,
-                  &tr.torque_right, &tr.pitch, &tr.roll, &tr.cmd_left, &tr.cmd_right})
-    reserve(*v);
   double last_yaw = 0, unwrap = 0;
-  auto record = [&](double t, double cl, double cr) {
+
+  TraceRecorder(Robot& robot, const ReplayOptions& opt, const ContactProbe& probe, const NeededChannels& need,
+                const RobotDescription& d, int n)
+      : robot(robot), opt(opt), probe(probe), need(need), su(d.treels.speed_unit), tu(d.treels.torque_unit) {
+    for (auto* v : {&tr.t, &tr.x, &tr.y, &tr.yaw, &tr.v, &tr.w, &tr.speed_left, &tr.speed_right, &tr.torque_left,
+                    &tr.torque_right, &tr.pitch, &tr.roll, &tr.cmd_left, &tr.cmd_right})
+      v->reserve(n + 1);
+  }
+
+  void record(double t, double cl, double cr) {
     const Pose p = robot.basePose();
     const Vec3 rpy = rpyFromQuat(p.orientation);
     // Inclinometer: attitude against the true vertical (gravity), which differs from world z only
@@ -236,85 +239,69 @@ RunPrediction replayDrive(World& world, const RobotDescription& d, const Dataset
     tr.cmd_left.push_back(cl);
     tr.cmd_right.push_back(cr);
     tr.contact.push_back(probe.touching ? 1 : 0);
-    if (need_tilt) {
+    if (need.tilt) {
       tr.pitch.push_back(tilt_rpy.y());
       tr.roll.push_back(tilt_rpy.x());
     }
-    if (need_speed) {
+    if (need.speed) {
       tr.speed_left.push_back(robot.encoderSpeed(0) / su);
       tr.speed_right.push_back(robot.encoderSpeed(1) / su);
     }
-    if (need_torque) {
+    if (need.torque) {
       tr.torque_left.push_back(robot.trackTorqueLeft() / tu);
       tr.torque_right.push_back(robot.trackTorqueRight() / tu);
     }
-  };
+  }
+};
 
-  // Sensor samples are computed at the step nearest to each requested time stamp.
-  std::vector<std::pair<int, std::string>> sensor_due;  // (step, channel)
-  std::map<std::string, std::vector<double>> sensor_values;
-  std::map<std::string, std::map<std::string, std::vector<double>>> sensor_features;
-  std::map<std::string, std::vector<std::string>> sensor_surface;
-  SensorBridge bridge(world, robot, ds);
-  for (const auto& c : sensor_channels) {
-    const Series& s = run.channels.at(c);
-    sensor_values[c].assign(s.t.size(), kNaN);
-    sensor_features[c]["distance"].assign(s.t.size(), kNaN);
-    sensor_features[c]["incidence"].assign(s.t.size(), kNaN);
-    sensor_surface[c].assign(s.t.size(), "");
-  }
-  std::map<int, std::vector<std::pair<std::string, std::size_t>>> due;
-  std::set<std::string> absent_sensors;
-  if (bridge.available()) {
-    for (const auto& c : sensor_channels) {
+/// The sensor channels' samples, each computed at the step nearest to its requested time stamp.
+struct SensorSampler {
+  SensorBridge bridge;
+  std::map<int, std::vector<std::pair<std::string, std::size_t>>> due;  ///< step -> (channel, sample)
+  std::map<std::string, std::vector<double>> values;
+  std::map<std::string, std::map<std::string, std::vector<double>>> features;
+  std::map<std::string, std::vector<std::string>> surface;
+  std::set<std::string> absent;  ///< channels the level has no sensor for
+
+  SensorSampler(World& world, Robot& robot, const Dataset& ds, const Run& run, const std::vector<std::string>& channels,
+                int n, double dt, std::vector<std::string>& notes)
+      : bridge(world, robot, ds) {
+    for (const auto& c : channels) {
       const Series& s = run.channels.at(c);
-      for (std::size_t i = 0; i < s.t.size(); ++i)
-        due[std::max(0, std::min(n, static_cast<int>(std::lround(s.t[i] / dt))))].push_back({c, i});
+      values[c].assign(s.t.size(), kNaN);
+      features[c]["distance"].assign(s.t.size(), kNaN);
+      features[c]["incidence"].assign(s.t.size(), kNaN);
+      surface[c].assign(s.t.size(), "");
     }
-  } else if (!sensor_channels.empty()) {
-    out.notes.push_back("sensor channels not simulated: " + bridge.whyUnavailable());
+    if (bridge.available()) {
+      for (const auto& c : channels) {
+        const Series& s = run.channels.at(c);
+        for (std::size_t i = 0; i < s.t.size(); ++i)
+          due[std::max(0, std::min(n, static_cast<int>(std::lround(s.t[i] / dt))))].push_back({c, i});
+      }
+    } else if (!channels.empty()) {
+      notes.push_back("sensor channels not simulated: " + bridge.whyUnavailable());
+    }
   }
-  auto sampleSensors = [&](int k) {
+
+  void sample(int k) {
     auto it = due.find(k);
     if (it == due.end()) return;
     for (const auto& [c, i] : it->second) {
       SensorReading rd = bridge.read(c);
-      if (std::isnan(rd.value)) absent_sensors.insert(c);
-      sensor_values[c][i] = rd.value;
-      sensor_features[c]["distance"][i] = rd.distance;
-      sensor_features[c]["incidence"][i] = rd.incidence;
-      sensor_surface[c][i] = rd.surface;
+      if (std::isnan(rd.value)) absent.insert(c);
+      values[c][i] = rd.value;
+      features[c]["distance"][i] = rd.distance;
+      features[c]["incidence"][i] = rd.incidence;
+      surface[c][i] = rd.surface;
     }
-  };
-
-  auto c0 = run.commandAt(0);
-  probe.touching = false;
-  record(0, c0.first, c0.second);
-  sampleSensors(0);
-  for (int k = 0; k < n; ++k) {
-    const double t = k * dt;
-    const auto c = run.commandAt(t);
-    if (run.passiveAt(t)) {
-      robot.setTracksPassive(true);
-    } else {
-      robot.setTrackSpeeds(c.first * su, c.second * su);
-    }
-    const auto force = run.forceAt(t);
-    if (force.first != 0 || force.second != 0) robot.addBaseForce(Vec3(force.first, force.second, 0));
-    probe.touching = false;
-    world.step();
-    record((k + 1) * dt, c.first, c.second);
-    sampleSensors(k + 1);
   }
-  for (const auto& c : absent_sensors) out.notes.push_back(c + " not simulated: level " + d.level + " has no such sensor");
-  // acceleration by central differences of v
-  tr.accel.assign(tr.v.size(), 0);
-  for (std::size_t i = 1; i + 1 < tr.v.size(); ++i) tr.accel[i] = (tr.v[i + 1] - tr.v[i - 1]) / (2 * dt);
+};
 
-  // Predictions at the measurement times.
+/// The predictions at the measurement times, with the features the diagnosis regresses on.
+void predictAtSamples(const Run& run, const Trace& tr, double dt, SensorSampler& sensors, RunPrediction& out) {
   for (const auto& [c, s] : run.channels) {
-    const std::string g = NoiseModel::group(c);
-    std::vector<double>* src = nullptr;
+    const std::vector<double>* src = nullptr;
     if (c == "x") src = &tr.x;
     else if (c == "y") src = &tr.y;
     else if (c == "yaw") src = &tr.yaw;
@@ -327,10 +314,10 @@ RunPrediction replayDrive(World& world, const RobotDescription& d, const Dataset
     std::vector<double> vals(s.t.size(), kNaN);
     if (src) {
       for (std::size_t i = 0; i < s.t.size(); ++i) vals[i] = interp(*src, dt, s.t[i]);
-    } else if (sensor_values.count(c)) {
-      vals = sensor_values[c];
-      out.features[c] = sensor_features[c];
-      out.surface[c] = sensor_surface[c];
+    } else if (sensors.values.count(c)) {
+      vals = sensors.values[c];
+      out.features[c] = sensors.features[c];
+      out.surface[c] = sensors.surface[c];
     }
     out.values[c] = std::move(vals);
     auto& f = out.features[c];
@@ -347,8 +334,54 @@ RunPrediction replayDrive(World& world, const RobotDescription& d, const Dataset
       const std::size_t k = std::min(tr.contact.size() - 1, static_cast<std::size_t>(std::lround(s.t[i] / dt)));
       f["contact"][i] = tr.contact[k];
     }
-    (void)g;
   }
+}
+
+RunPrediction replayDrive(World& world, const RobotDescription& d, const Dataset& ds, const Run& run,
+                          const Pose2D& start, const ReplayOptions& opt, ContactProbe& probe) {
+  RunPrediction out;
+  Robot& robot = world.addRobot(d, start, "sbot_0");
+  const double dt = world.config().step;
+  const int settle = static_cast<int>(std::round(opt.settle / dt));
+  robot.setTrackSpeeds(0, 0);
+  world.stepN(settle);
+  for (const auto& e : world.effects()) {
+    e->reset();
+    if (auto* sag = dynamic_cast<BatterySagEffect*>(e.get())) sag->setElapsed(robot.name(), run.start_time);
+  }
+
+  const NeededChannels need = neededChannels(run, opt);
+  const double su = d.treels.speed_unit;
+  const int n = static_cast<int>(std::ceil(run.t_end / dt - 1e-9)) + 1;
+  TraceRecorder rec(robot, opt, probe, need, d, n);
+  SensorSampler sensors(world, robot, ds, run, need.sensors, n, dt, out.notes);
+
+  auto c0 = run.commandAt(0);
+  probe.touching = false;
+  rec.record(0, c0.first, c0.second);
+  sensors.sample(0);
+  for (int k = 0; k < n; ++k) {
+    const double t = k * dt;
+    const auto c = run.commandAt(t);
+    if (run.passiveAt(t)) {
+      robot.setTracksPassive(true);
+    } else {
+      robot.setTrackSpeeds(c.first * su, c.second * su);
+    }
+    const auto force = run.forceAt(t);
+    if (force.first != 0 || force.second != 0) robot.addBaseForce(Vec3(force.first, force.second, 0));
+    probe.touching = false;
+    world.step();
+    rec.record((k + 1) * dt, c.first, c.second);
+    sensors.sample(k + 1);
+  }
+  for (const auto& c : sensors.absent) out.notes.push_back(c + " not simulated: level " + d.level + " has no such sensor");
+  Trace& tr = rec.tr;
+  // acceleration by central differences of v
+  tr.accel.assign(tr.v.size(), 0);
+  for (std::size_t i = 1; i + 1 < tr.v.size(); ++i) tr.accel[i] = (tr.v[i + 1] - tr.v[i - 1]) / (2 * dt);
+
+  predictAtSamples(run, tr, dt, sensors, out);
   if (opt.keep_trace) out.trace = std::move(tr);
   if (opt.align && ds.align_initial_pose) out.alignment = alignSegments(run, out, ds.noise, ds.align_segment);
   return out;
