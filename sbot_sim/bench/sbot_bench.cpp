@@ -271,6 +271,26 @@ void runOne(const Options& o, int n) {
   std::fflush(stdout);
 }
 
+/// Runs `work` in a child process and returns its wait status: the child exits 0, or, when `work`
+/// throws, prints `sbot_bench: <prefix><what()>` and exits `refusal`. Each row (and the scenario
+/// check) runs in its own process so that its peak memory is its own.
+template <typename Work>
+int statusOfChild(Work work, const char* prefix, int refusal) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    try {
+      work();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "sbot_bench: %s%s\n", prefix, e.what());
+      std::_Exit(refusal);
+    }
+    std::_Exit(0);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return status;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -283,19 +303,12 @@ int main(int argc, char** argv) {
     // Checked here, before any row, so that a malformed file (or a count it cannot take) is refused
     // once with exit status 2: every robot the file lists (also those a --robots count leaves out),
     // and every world a row will build, built in a child so that the rows' peak memory stays their own.
-    const pid_t pid = fork();
-    if (pid == 0) {
-      try {
-        sbot::loadScenario(o.scenario, -1);
-        for (int n : o.robots) sbot::buildScenarioWorld(sbot::loadScenario(o.scenario, n));
-      } catch (const std::exception& e) {
-        std::fprintf(stderr, "sbot_bench: --scenario: %s\n", e.what());
-        std::_Exit(sbot_tools::kExitBadInput);
-      }
-      std::_Exit(0);
-    }
-    int status = 0;
-    waitpid(pid, &status, 0);
+    const int status = statusOfChild(
+        [&] {
+          sbot::loadScenario(o.scenario, -1);
+          for (int n : o.robots) sbot::buildScenarioWorld(sbot::loadScenario(o.scenario, n));
+        },
+        "--scenario: ", sbot_tools::kExitBadInput);
     if (WIFEXITED(status) && WEXITSTATUS(status) == sbot_tools::kExitBadInput) return sbot_tools::kExitBadInput;
     if (const int outcome = sbot_tools::workerOutcome("sbot_bench", "checking the scenario", status)) return outcome;
     std::printf("sbot_bench: headless core, scenario %s, %s, 1 core per run\n", o.scenario.c_str(),
@@ -307,18 +320,7 @@ int main(int argc, char** argv) {
   std::fflush(stdout);
   int exit_status = sbot_tools::kExitDone;
   for (int n : o.robots) {
-    const pid_t pid = fork();
-    if (pid == 0) {
-      try {
-        runOne(o, n);
-      } catch (const std::exception& e) {
-        std::fprintf(stderr, "sbot_bench: %s\n", e.what());
-        std::_Exit(sbot_tools::kExitFailure);
-      }
-      std::_Exit(0);
-    }
-    int status = 0;
-    waitpid(pid, &status, 0);
+    const int status = statusOfChild([&] { runOne(o, n); }, "", sbot_tools::kExitFailure);
     // A run that dies must not leave its row silently missing.
     const std::string what = n < 0 ? std::string("the run of the scenario's robots") : "the run with " + std::to_string(n) + " robots";
     const int outcome = sbot_tools::workerOutcome("sbot_bench", what, status);
